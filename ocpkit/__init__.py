@@ -1,0 +1,22 @@
+"""ocpkit: robot motion planning as an optimal control problem (path and timing together).
+
+Public API: load_scenario, load_robot, Problem, plan, Trajectory, verify.
+"""
+
+import os
+
+# One BLAS thread: the NLPs are small and threading only costs kernel time on few cores. Must precede numpy.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+from ocpkit import dynamics, solvers, transcription  # noqa: E402,F401  (register built-in components)
+from ocpkit.planner import Plan, plan  # noqa: E402
+from ocpkit.problem import Problem, TimeBounds  # noqa: E402
+from ocpkit.robots import Robot, load_robot  # noqa: E402
+from ocpkit.scenario import load_scenario  # noqa: E402
+from ocpkit.scene import Scene, Workspace  # noqa: E402
+from ocpkit.trajectory import Trajectory, write_json  # noqa: E402
+from ocpkit.verify import Verification, verify  # noqa: E402
+
+__all__ = ["Plan", "Problem", "Robot", "Scene", "TimeBounds", "Trajectory", "Verification", "Workspace",
+           "load_robot", "load_scenario", "plan", "verify", "write_json"]

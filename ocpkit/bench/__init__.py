@@ -1,0 +1,1 @@
+"""Benchmark suites: `paper` reproduces the seed paper's Table II."""

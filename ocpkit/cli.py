@@ -1,0 +1,75 @@
+"""Command line: `ocpkit plan SCENARIO` and `ocpkit bench paper`. User mistakes print one line, exit 2."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from pathlib import Path
+
+from ocpkit.errors import OcpkitError
+
+
+def _plan_command(args: argparse.Namespace) -> int:
+    from ocpkit import load_scenario, plan
+    from ocpkit.report import trajectory_header
+    from ocpkit.trajectory import write_json
+
+    problem = load_scenario(args.scenario)
+    if args.mu is not None:
+        problem = dataclasses.replace(problem, mu=args.mu)
+    result = plan(problem, planner=args.planner, transcription=args.transcription, knots=args.knots,
+                  dynamics=args.dynamics, solver=args.solver)
+    v = result.verification
+    print(f"{problem.name}: status {result.status}, t_f = {result.trajectory.tf:.3f} s "
+          f"(velocity bound {problem.velocity_lower_bound():.3f} s), solve {result.stats.solve_time:.3f} s "
+          f"+ set-up {result.stats.setup_time:.3f} s, {result.stats.iterations} iterations, "
+          f"{result.stats.rounds} refinement rounds")
+    print(f"checks: {v.summary()}")
+    if args.output:
+        write_json(args.output, result.trajectory, trajectory_header(problem, result))
+        print(f"wrote {args.output}")
+    return 0 if result.ok else 1
+
+
+def _bench_command(args: argparse.Namespace) -> int:
+    from ocpkit.bench.paper import run_paper_benchmark
+
+    run_paper_benchmark(Path(args.scenarios), Path(args.out), repeats=args.repeats)
+    return 0
+
+
+def parser() -> argparse.ArgumentParser:
+    """The `ocpkit` argument parser."""
+    main = argparse.ArgumentParser(prog="ocpkit", description=__doc__)
+    commands = main.add_subparsers(dest="command", required=True)
+    p = commands.add_parser("plan", help="plan one scenario file and verify the result")
+    p.add_argument("scenario", help="scenario YAML file")
+    p.add_argument("--planner", default="simultaneous")
+    p.add_argument("--transcription", default="chebyshev")
+    p.add_argument("--knots", type=int, default=12, help="number of knot intervals N (default 12)")
+    p.add_argument("--dynamics", default="casadi")
+    p.add_argument("--solver", default="ipopt")
+    p.add_argument("--mu", type=float, default=None, help="jerk weight μ (default: the scenario's)")
+    p.add_argument("-o", "--output", help="write the trajectory JSON here")
+    p.set_defaults(run=_plan_command)
+    b = commands.add_parser("bench", help="run a benchmark suite")
+    b.add_argument("suite", choices=["paper"])
+    b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml")
+    b.add_argument("--out", default="results/paper", help="output folder (results.csv, trajectories/)")
+    b.add_argument("--repeats", type=int, default=5, help="solves per plan; the median is reported")
+    b.set_defaults(run=_bench_command)
+    return main
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except OcpkitError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

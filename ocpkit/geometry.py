@@ -1,0 +1,69 @@
+"""Numeric sphere geometry with pinocchio: sphere centres and signed clearances (metres).
+
+A clearance is ≥ 0 when free: centre distance minus radii for sphere pairs, distance to the box face
+minus radius for the workspace. This module is the single numeric reference used by scenario checks,
+`verify` and the baselines' validity checker.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ocpkit.robots import Robot
+from ocpkit.scene import Scene
+
+
+def sphere_centers(robot: Robot, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+    """World positions of the robot's spheres at configurations q (n,) or (K, n): shape (M, 3) or (K, M, 3)."""
+    data = data or robot.model.createData()
+    joints, index = np.unique(robot.sphere_joint, return_inverse=True)
+    qs = np.atleast_2d(q)
+    poses = np.empty((len(qs), len(joints), 4, 4))  # homogeneous world pose of every sphere-carrying joint
+    for k, qk in enumerate(qs):
+        pin.forwardKinematics(robot.model, data, qk)
+        poses[k] = [data.oMi[j].homogeneous for j in joints.tolist()]
+    sphere_poses = poses[:, index]
+    out = np.einsum("kmij,mj->kmi", sphere_poses[..., :3, :3], robot.sphere_offset) + sphere_poses[..., :3, 3]
+    return out[0] if np.ndim(q) == 1 else out
+
+
+@dataclass(frozen=True)
+class Clearances:
+    """Signed clearances (m) for K configurations: self (K, P), obstacle (K, M, S), workspace (K, M, 6)."""
+
+    self_pairs: np.ndarray
+    obstacles: np.ndarray
+    workspace: np.ndarray
+
+
+def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:
+    """Clearances of sphere centres (K, M, 3) against each other, the obstacles and the workspace box."""
+    r = robot.sphere_radius
+    a, b = robot.self_collision.T if len(robot.self_collision) else (np.zeros(0, int), np.zeros(0, int))
+    self_pairs = np.linalg.norm(centers[:, a] - centers[:, b], axis=-1) - (r[a] + r[b])
+    gaps = centers[:, :, None, :] - scene.obstacle_centers[None, None]
+    obstacles = np.linalg.norm(gaps, axis=-1) - (r[:, None] + scene.obstacle_radii[None, :])
+    if scene.workspace is None:
+        workspace = np.zeros((len(centers), len(r), 0))
+    else:
+        below = centers - scene.workspace.lower - r[:, None]
+        above = scene.workspace.upper - centers - r[:, None]
+        workspace = np.concatenate([below, above], axis=-1)
+    return Clearances(self_pairs, obstacles, workspace)
+
+
+def collision_report(robot: Robot, scene: Scene, q: np.ndarray) -> list[str]:
+    """Human-readable list of every sphere contact at configuration q (n,); empty when collision-free."""
+    c = clearances(robot, scene, sphere_centers(robot, q)[None])
+    link = robot.sphere_link
+    lines = [f"self-collision: sphere {i} ({link[i]}) and sphere {j} ({link[j]}) overlap by {-d:.3f} m"
+             for (i, j), d in zip(robot.self_collision, c.self_pairs[0]) if d < 0]
+    lines += [f"sphere {m} ({link[m]}) overlaps obstacle {s} by {-c.obstacles[0, m, s]:.3f} m"
+              for m, s in zip(*np.nonzero(c.obstacles[0] < 0))]
+    faces = ["x min", "y min", "z min", "x max", "y max", "z max"]
+    lines += [f"sphere {m} ({link[m]}) leaves the workspace at {faces[f]} by {-c.workspace[0, m, f]:.3f} m"
+              for m, f in zip(*np.nonzero(c.workspace[0] < 0))]
+    return lines

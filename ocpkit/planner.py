@@ -1,0 +1,115 @@
+"""`plan`: the one call that solves a Problem with a chosen planner and components, then verifies it.
+
+The simultaneous planner (transcription + dynamics + solver) builds one NLP per problem shape and caches
+it with its prepared solver, so a second query of the same shape pays no set-up. After each solve the
+trajectory is verified densely; where a path constraint is violated between check times, the adaptive
+check slots are moved there and the NLP is re-solved warm-started, for at most `refinements` rounds.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ocpkit.problem import Problem
+from ocpkit.registry import Registry
+from ocpkit.solvers.base import SOLVERS, Solver, SolverStatus
+from ocpkit.trajectory import Trajectory
+from ocpkit.transcription.base import NLP, TRANSCRIPTIONS
+from ocpkit.verify import Verification, verify
+
+PLANNERS: Registry[Any] = Registry("planner", "ocpkit.planners")
+
+
+@dataclass(frozen=True)
+class PlanStats:
+    """Timing (s) and effort of one plan: set-up is the one-time build (0 when cached)."""
+
+    solve_time: float
+    setup_time: float
+    iterations: int
+    rounds: int
+    solver_message: str
+    extra: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A planned trajectory with its status: `verified` only if the dense verification passed.
+
+    Other statuses: `violated` (solver converged, verification failed), `infeasible`, `iteration_limit`,
+    `time_limit`, `failed` (the solver's word)."""
+
+    trajectory: Trajectory
+    status: str
+    verification: Verification
+    stats: PlanStats
+    method: dict
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "verified"
+
+
+_BUILDS: dict[tuple, tuple[NLP, Solver, float]] = {}
+
+
+def prepared(problem: Problem, transcription: str, dynamics: str, solver: str,
+             transcription_options: dict, solver_options: dict) -> tuple[NLP, Solver, float]:
+    """The cached (NLP, prepared solver, set-up seconds) for this problem's shape; builds on first use."""
+    method = TRANSCRIPTIONS.get(transcription)(**transcription_options)
+    key = (method.shape_key(problem, dynamics), solver, tuple(sorted(solver_options.items())))
+    if key not in _BUILDS:
+        start = time.perf_counter()
+        nlp = method.build(problem, dynamics)
+        nlp_solver = SOLVERS.get(solver)(**solver_options)
+        nlp_solver.prepare(nlp)
+        _BUILDS[key] = (nlp, nlp_solver, time.perf_counter() - start)
+        return _BUILDS[key]
+    nlp, nlp_solver, _ = _BUILDS[key]
+    return nlp, nlp_solver, 0.0
+
+
+def plan(problem: Problem, planner: str = "simultaneous", **options: Any) -> Plan:
+    """Plan `problem` with the named planner; options go to that planner (see `plan_simultaneous`)."""
+    return PLANNERS.get(planner)(problem, **options)
+
+
+def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str = "casadi",
+                      solver: str = "ipopt", guess: np.ndarray | None = None, refinements: int = 3,
+                      transcription_options: dict | None = None, solver_options: dict | None = None) -> Plan:
+    """Path and timing together as one optimal control problem (the paper's method).
+
+    `knots` is N (N + 1 knot points for Chebyshev); `guess` a decision vector for this shape (default:
+    the transcription's straight-line rule); `refinements` bounds the re-solve rounds."""
+    start = time.perf_counter()
+    nlp, nlp_solver, setup = prepared(problem, transcription, dynamics, solver,
+                                      {"knots": knots, **(transcription_options or {})}, solver_options or {})
+    bounds = nlp.bounds(problem)
+    w = nlp.initial_guess(problem) if guess is None else guess
+    fractions = np.zeros(0)
+    iterations, rounds = 0, 0
+    while True:
+        result = nlp_solver.solve(nlp, w, nlp.parameters(problem, fractions), bounds)
+        iterations += result.iterations
+        trajectory = nlp.decode(result.w)
+        verification = verify(problem, trajectory)
+        fresh = verification.violation_times / trajectory.tf
+        if verification.ok or result.status != SolverStatus.CONVERGED or rounds >= refinements or not len(fresh):
+            break
+        fractions = np.concatenate([fresh, fractions])  # newest violations take the slots first
+        w, rounds = result.w, rounds + 1
+    if result.status != SolverStatus.CONVERGED:
+        status = result.status.value
+    else:
+        status = "verified" if verification.ok else "violated"
+    method = {"planner": "simultaneous", "transcription": transcription, "knots": knots, "dynamics": dynamics,
+              "solver": solver}
+    stats = PlanStats(time.perf_counter() - start - setup, setup, iterations, rounds, result.message)
+    return Plan(trajectory, status, verification, stats, method)
+
+
+PLANNERS.register("simultaneous", plan_simultaneous)

@@ -1,0 +1,24 @@
+"""What a plan reports outside: the JSON header and the results-table row."""
+
+from __future__ import annotations
+
+from ocpkit.planner import Plan
+from ocpkit.problem import Problem
+
+RESULT_COLUMNS = ("suite", "case", "planner", "transcription", "knots", "solver", "dynamics", "status", "tf",
+                  "solve_time_s", "setup_time_s", "iterations", "max_violation")
+
+
+def trajectory_header(problem: Problem, plan: Plan) -> dict:
+    """Header fields of the trajectory JSON for `plan`."""
+    return {"robot": problem.robot.name, "joint_names": list(problem.robot.joint_names), "method": plan.method,
+            "status": plan.status, "solve_time_s": plan.stats.solve_time, "iterations": plan.stats.iterations}
+
+
+def result_row(suite: str, case: str, plan: Plan, solve_time: float, setup_time: float) -> dict:
+    """One results.csv row; max_violation is the worst check's value minus its tolerance (≤ 0 passes; units of that check)."""
+    worst = plan.verification.worst
+    return {"suite": suite, "case": case, **{k: plan.method.get(k, "") for k in
+            ("planner", "transcription", "knots", "solver", "dynamics")}, "status": plan.status,
+            "tf": f"{plan.trajectory.tf:.4f}", "solve_time_s": f"{solve_time:.4f}", "setup_time_s": f"{setup_time:.3f}",
+            "iterations": plan.stats.iterations, "max_violation": f"{worst.worst - worst.tolerance:.3g}"}

@@ -1,0 +1,128 @@
+"""Dense numeric re-check of a trajectory against its problem, with pinocchio (independent of CasADi).
+
+Every check reports its worst value over a dense time grid (1 ms by default) and passes when that is
+within the stated tolerance:
+
+  position, velocity, torque, torque_rate   worst excess over the limit, relative (position: to the joint's
+                                             range; others: to the limit itself);  tolerance 1 %
+  dynamics    |tau(t) − (rnea(q, qd, qdd) + friction)| relative to the torque range 2·tau_max;  tolerance 1 %
+  self_collision, obstacle, workspace       worst sphere penetration, metres (negative: the smallest
+                                             clearance);  tolerance 0 (no contact allowed)
+  boundary    |q − q_start/goal|, |qd|, |qdd| at t = 0 and t_f (rad, rad/s, rad/s²);  tolerance 1e-6
+
+The torque limit is checked on the inverse-dynamics torque, i.e. the torque the motion really needs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.problem import Problem
+from ocpkit.trajectory import Samples, Trajectory
+
+LIMIT_TOLERANCE = 0.01
+DYNAMICS_TOLERANCE = 0.01
+GEOMETRY_TOLERANCE = 0.0
+BOUNDARY_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class Check:
+    """One verified quantity: its worst value, the tolerance it must not exceed, and when it occurred (s)."""
+
+    name: str
+    worst: float
+    tolerance: float
+    time: float
+    unit: str
+
+    @property
+    def ok(self) -> bool:
+        return bool(self.worst <= self.tolerance)
+
+
+@dataclass(frozen=True)
+class Verification:
+    """The result of `verify`: every check, and the sample times where fixable path violations occur."""
+
+    checks: tuple[Check, ...]
+    violation_times: np.ndarray  # (k,) seconds, worst first, of path-constraint violations
+
+    @property
+    def ok(self) -> bool:
+        return all(c.ok for c in self.checks)
+
+    @property
+    def worst(self) -> Check:
+        """The check furthest beyond (or closest to) its tolerance."""
+        return max(self.checks, key=lambda c: c.worst - c.tolerance)
+
+    def summary(self) -> str:
+        """One line: the failed checks with their times, or every check's worst value if all pass."""
+        failed = [c for c in self.checks if not c.ok]
+        if failed:
+            return "FAILED " + ", ".join(f"{c.name} {c.worst:+.3g} {c.unit} > {c.tolerance:g} at t={c.time:.3f} s"
+                                         for c in failed)
+        return "all pass: " + ", ".join(f"{c.name} {c.worst:+.3g} {c.unit}" for c in self.checks)
+
+
+def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verification:
+    """Re-check `trajectory` against every constraint of `problem` on a dense grid of step dt (s)."""
+    samples = trajectory.sample(dt)
+    robot = problem.robot
+    tau_needed = _inverse_dynamics(problem, samples)
+    excess = {
+        "position": np.maximum(samples.q - robot.q_upper, robot.q_lower - samples.q) / (robot.q_upper - robot.q_lower),
+        "velocity": np.abs(samples.qd) / robot.qd_max - 1.0,
+        "torque": np.abs(tau_needed) / robot.tau_max - 1.0,
+        "torque_rate": np.abs(samples.taud) / robot.taud_max - 1.0,
+    }
+    consistency = np.abs(samples.tau - tau_needed) / (2.0 * robot.tau_max)
+    c = clearances(robot, problem.scene, sphere_centers(robot, samples.q))
+    penetration = {"self_collision": -c.self_pairs, "obstacle": -c.obstacles, "workspace": -c.workspace}
+    checks = [_worst(name, v, LIMIT_TOLERANCE, samples.t, "rel") for name, v in excess.items()]
+    checks.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))
+    checks += [_worst(name, v, GEOMETRY_TOLERANCE, samples.t, "m") for name, v in penetration.items()]
+    checks.append(_boundary(problem, samples))
+    path_violation = np.max([_per_time(v) - LIMIT_TOLERANCE for v in excess.values()]
+                            + [_per_time(v) for v in penetration.values()], axis=0)
+    return Verification(tuple(checks), _peak_times(samples.t, path_violation))
+
+
+def _inverse_dynamics(problem: Problem, samples: Samples) -> np.ndarray:
+    robot = problem.robot
+    data = robot.model.createData()
+    tau = np.array([pin.rnea(robot.model, data, q, qd, qdd).copy()
+                    for q, qd, qdd in zip(samples.q, samples.qd, samples.qdd)])
+    return tau + robot.friction(samples.qd)
+
+
+def _per_time(values: np.ndarray) -> np.ndarray:
+    """Worst value at each sample time, shape (m,); -inf where there is nothing to check."""
+    flat = values.reshape(len(values), -1)
+    return flat.max(axis=1) if flat.shape[1] else np.full(len(values), -np.inf)
+
+
+def _worst(name: str, values: np.ndarray, tolerance: float, t: np.ndarray, unit: str) -> Check:
+    per_time = _per_time(values)
+    k = int(np.argmax(per_time))
+    return Check(name, float(per_time[k]), tolerance, float(t[k]), unit)
+
+
+def _boundary(problem: Problem, samples: Samples) -> Check:
+    errors = np.array([
+        np.abs(samples.q[0] - problem.start).max(), np.abs(samples.q[-1] - problem.goal).max(),
+        np.abs(samples.qd[[0, -1]]).max(), np.abs(samples.qdd[[0, -1]]).max()])
+    k = int(np.argmax(errors))
+    return Check("boundary", float(errors[k]), BOUNDARY_TOLERANCE, float(samples.t[-1] if k % 2 else 0.0), "abs")
+
+
+def _peak_times(t: np.ndarray, violation: np.ndarray) -> np.ndarray:
+    """Times of the local maxima of a violation signal where it is positive, worst first."""
+    padded = np.concatenate([[-np.inf], violation, [-np.inf]])
+    peaks = np.nonzero((violation > 0) & (violation >= padded[:-2]) & (violation >= padded[2:]))[0]
+    return t[peaks[np.argsort(-violation[peaks])]]

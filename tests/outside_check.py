@@ -1,0 +1,71 @@
+"""An outside checker that knows nothing of ocpkit: it reads a trajectory JSON, the robot's spec.yaml +
+URDF and the scenario YAML (for the scene), and re-checks the samples with pinocchio.
+
+Usage: python tests/outside_check.py TRAJECTORY.json SPEC.yaml ROBOT.urdf SCENARIO.yaml
+Prints one line per check and exits 1 if any fails: limits within 1 %, tau within 1 % of the torque range
+of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no sphere contact.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pinocchio as pin
+import yaml
+
+
+def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, float]:
+    """Worst value of every check: relative excess for limits, metres of penetration for geometry."""
+    model = pin.buildModelFromUrdf(urdf)
+    data = model.createData()
+    s = {k: np.asarray(v, dtype=float) for k, v in trajectory["samples"].items()}
+    lim, fr = spec["limits"], spec["friction"]
+    lower, upper = np.array(lim["position"]["lower"]), np.array(lim["position"]["upper"])
+    tau_max = np.array(lim["torque"])
+    rnea = np.array([pin.rnea(model, data, q, qd, qdd).copy() for q, qd, qdd in zip(s["q"], s["qd"], s["qdd"])])
+    needed = rnea + np.array(fr["viscous"]) * s["qd"] + np.array(fr["coulomb"]) * np.tanh(s["qd"] / fr["smoothing"])
+    rate = np.gradient(s["tau"], s["t"], axis=0)
+    worst = {
+        "position": np.max(np.maximum(s["q"] - upper, lower - s["q"]) / (upper - lower)),
+        "velocity": np.max(np.abs(s["qd"]) / np.array(lim["velocity"]) - 1),
+        "torque": np.max(np.abs(s["tau"]) / tau_max - 1),
+        "torque_rate": np.max(np.abs(rate) / np.array(lim["torque_rate"]) - 1),
+        "dynamics": np.max(np.abs(s["tau"] - needed) / (2 * tau_max)),
+    }
+    centres = []
+    for q in s["q"]:
+        pin.framesForwardKinematics(model, data, q)
+        centres.append([data.oMf[model.getFrameId(sp["link"])].act(np.array(sp["center"])) for sp in spec["spheres"]])
+    centres = np.array(centres)
+    radii = np.array([sp["radius"] for sp in spec["spheres"]])
+    pairs = np.array(spec["self_collision"])
+    gaps = np.linalg.norm(centres[:, pairs[:, 0]] - centres[:, pairs[:, 1]], axis=-1) - radii[pairs].sum(axis=1)
+    worst["self_collision"] = max(0.0, -gaps.min())
+    scene = scenario.get("scene", {})
+    for obstacle in scene.get("obstacles", []):
+        o = obstacle["sphere"]
+        gap = np.linalg.norm(centres - np.array(o["center"]), axis=-1) - radii - o["radius"]
+        worst["obstacle"] = max(worst.get("obstacle", 0.0), -gap.min())
+    if "workspace" in scene:
+        box = scene["workspace"]
+        inside = np.minimum(centres - radii[:, None] - box["min"], box["max"] - centres - radii[:, None])
+        worst["workspace"] = max(0.0, -inside.min())
+    return worst
+
+
+def main(argv: list[str]) -> int:
+    trajectory_file, spec_file, urdf, scenario_file = argv
+    with open(trajectory_file) as t, open(spec_file) as sp, open(scenario_file) as sc:
+        worst = check(json.load(t), yaml.safe_load(sp), urdf, yaml.safe_load(sc))
+    failed = False
+    for name, value in worst.items():
+        ok = value <= (0.0 if name in ("self_collision", "obstacle", "workspace") else 0.01)
+        failed |= not ok
+        print(f"{name:15s} {value:+.4f} {'ok' if ok else 'FAIL'}")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
