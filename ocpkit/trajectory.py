@@ -37,9 +37,9 @@ class Trajectory:
         return float(self.knots.t[-1])
 
     def sample(self, dt: float = 1e-3) -> Samples:
-        """The interpolant on a uniform grid of step dt (s) from 0 to tf, both ends included."""
-        count = max(int(np.ceil(self.tf / dt)), 1)
-        return self.interpolant(np.linspace(0.0, self.tf, count + 1))
+        """The interpolant at t = 0, dt, 2 dt, ... and at tf (the last step may be shorter), seconds."""
+        grid = dt * np.arange(int(np.ceil(self.tf / dt - 1e-9)))
+        return self.interpolant(np.append(grid, self.tf))
 
 
 def write_json(path: str | Path, trajectory: Trajectory, header: dict[str, Any], dt: float = 1e-3) -> None:

@@ -50,6 +50,10 @@ class NLP(ABC):
     def decode(self, w: np.ndarray) -> Trajectory:
         """The trajectory that the decision vector w represents."""
 
+    @abstractmethod
+    def encode(self, trajectory: Trajectory) -> np.ndarray:
+        """A decision vector w that samples `trajectory` (any planner's) on this NLP's grid: a warm start."""
+
 
 class Transcription(ABC):
     """Builds an NLP from a problem; `shape_key` says which problems share a build."""

@@ -160,17 +160,26 @@ class ChebyshevNLP(NLP):
     def initial_guess(self, problem: Problem) -> np.ndarray:
         """Straight joint-space line from start to goal at constant speed over t_f = time.guess (infeasible
         at the ends, as in the paper), with the rigid-body torque that holds it: rnea(q, qd, 0)."""
-        tf, r = problem.time.guess, self.robot
-        fraction = (self.s_knots + 1.0) / 2.0
-        q = problem.start + np.outer(fraction, problem.goal - problem.start)
-        qd = np.tile((problem.goal - problem.start) / tf, (self.N + 1, 1))
+        tf, delta = problem.time.guess, problem.goal - problem.start
+
+        def line(t: np.ndarray) -> Samples:
+            zeros = np.zeros((len(t), self.n))
+            return Samples(t, problem.start + np.outer(t / tf, delta), np.tile(delta / tf, (len(t), 1)), zeros,
+                           zeros, zeros)
+
+        return self.encode(Trajectory(line(np.array([0.0, tf])), line))
+
+    def encode(self, trajectory: Trajectory) -> np.ndarray:
+        """Sample `trajectory` at this NLP's knots and check times (scaled to its t_f); u is the rigid-body
+        torque rnea(q, qd, qdd) / tau_max of the sampled motion."""
+        tf, r = trajectory.tf, self.robot
+        at = lambda s: trajectory.interpolant(tf * (s + 1.0) / 2.0)  # noqa: E731
+        knots, checks = at(self.s_knots), at(np.concatenate([self.check_s, self.adaptive_default]))
         data = r.model.createData()
-        tau = np.array([pin.rnea(r.model, data, qi, qdi, np.zeros(self.n)).copy() for qi, qdi in zip(q, qd)])
-        u = tau / r.tau_max
-        columns = np.hstack([q, qd, np.zeros_like(q), u])
-        check_s = np.concatenate([self.check_s, self.adaptive_default])
-        q_checks = problem.start + np.outer((check_s + 1.0) / 2.0, problem.goal - problem.start)
-        return np.concatenate([columns.ravel(), q_checks.ravel(), [tf]])
+        rigid = np.array([pin.rnea(r.model, data, q, qd, qdd).copy()
+                          for q, qd, qdd in zip(knots.q, knots.qd, knots.qdd)])
+        columns = np.hstack([knots.q, knots.qd, knots.qdd, rigid / r.tau_max])
+        return np.concatenate([columns.ravel(), checks.q.ravel(), [tf]])
 
     def decode(self, w: np.ndarray) -> Trajectory:
         n, N = self.n, self.N

@@ -1,0 +1,95 @@
+"""End-to-end planning: the paper cases verify, shapes are reused, failures are reported as statuses, and
+the exported JSON passes an outside check that knows nothing of ocpkit."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+from helpers import REPO
+
+import ocpkit
+from ocpkit.bench.paper import run_paper_benchmark
+from ocpkit.cli import main
+from ocpkit.report import RESULT_COLUMNS, trajectory_header
+
+CASES = sorted((REPO / "scenarios/paper").glob("case*.yaml"))
+DATA = REPO / "ocpkit/robots/data/industrial6"
+pytestmark = pytest.mark.slow
+
+
+@pytest.mark.parametrize("knots", [12, 8])
+@pytest.mark.parametrize("case", CASES, ids=lambda p: p.stem)
+def test_paper_case_is_verified(case, knots):
+    problem = ocpkit.load_scenario(case)
+    result = ocpkit.plan(problem, knots=knots)
+    assert result.status == "verified", result.verification.summary()
+    assert problem.velocity_lower_bound() < result.trajectory.tf < 3.0
+
+
+def test_second_query_of_a_shape_reuses_the_build():
+    problem = ocpkit.load_scenario(CASES[1])
+    ocpkit.plan(problem, knots=8)
+    moved = dataclasses.replace(problem, scene=dataclasses.replace(
+        problem.scene, obstacle_centers=problem.scene.obstacle_centers + [0.0, 0.05, 0.0]))
+    again = ocpkit.plan(moved, knots=8)
+    assert again.stats.setup_time == 0.0
+    assert again.ok, again.verification.summary()
+
+
+def test_iteration_limit_is_a_status_not_a_success():
+    problem = ocpkit.load_scenario(CASES[0])
+    result = ocpkit.plan(problem, knots=8, solver_options={"max_iterations": 3})
+    assert result.status == "iteration_limit" and not result.ok
+
+
+def test_time_bound_below_what_the_torques_allow_is_not_verified():
+    problem = ocpkit.load_scenario(CASES[0])
+    rushed = dataclasses.replace(problem, time=ocpkit.TimeBounds(0.1, problem.velocity_lower_bound() * 1.02, 0.5))
+    result = ocpkit.plan(rushed, knots=8)
+    assert result.status in ("infeasible", "failed", "violated") and not result.ok
+
+
+def test_exported_json_passes_the_outside_check(tmp_path):
+    problem = ocpkit.load_scenario(CASES[0])
+    result = ocpkit.plan(problem, knots=12)
+    path = tmp_path / "case1.json"
+    ocpkit.write_json(path, result.trajectory, trajectory_header(problem, result))
+    document = json.loads(path.read_text())
+    assert document["format"] == "ocpkit.trajectory/1" and document["status"] == "verified"
+    assert document["samples"]["t"][1] == pytest.approx(0.001)
+    assert document["samples"]["t"][-1] == pytest.approx(document["tf"])
+    check = subprocess.run([sys.executable, str(REPO / "tests/outside_check.py"), str(path), str(DATA / "spec.yaml"),
+                            str(DATA / "robot.urdf"), str(CASES[0])], capture_output=True, text=True)
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_cli_plan_prints_status_and_writes_json(tmp_path, capsys):
+    out = tmp_path / "t.json"
+    assert main(["plan", str(CASES[2]), "--knots", "8", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "status verified" in printed and "iterations" in printed and "checks: all pass" in printed
+    assert json.loads(out.read_text())["method"]["knots"] == 8
+
+
+def test_cli_reports_user_mistakes_in_one_line(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("robot: robby\nunit: deg\nstart: [0]\ngoal: [0]\n")
+    assert main(["plan", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "unknown robot 'robby'" in err and "Traceback" not in err
+
+
+def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
+    shutil.copy(CASES[3], tmp_path / CASES[3].name)
+    run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1)
+    rows = list(csv.DictReader((tmp_path / "out/results.csv").open()))
+    assert tuple(rows[0]) == RESULT_COLUMNS
+    assert [(r["case"], r["knots"], r["status"]) for r in rows] == [("case4", "12", "verified"), ("case4", "8", "verified")]
+    assert (tmp_path / "out/trajectories/case4-simultaneous-chebyshev-12.json").exists()
+    assert "one-time set-up" in capsys.readouterr().out

@@ -1,0 +1,81 @@
+"""Robot loading: built-in data, custom URDF + spec files, and clear errors for broken files."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+from helpers import REPO, example_robot_urdf
+
+from ocpkit import load_robot
+from ocpkit.errors import RobotError
+from ocpkit.robots import builtin_robots
+
+SPEC = REPO / "ocpkit/robots/data/industrial6/spec.yaml"
+
+
+def write_spec(path, **changes) -> None:
+    spec = yaml.safe_load(SPEC.read_text())
+    spec.update(changes)
+    path.write_text(yaml.safe_dump(spec))
+
+
+def test_builtin_industrial6():
+    robot = load_robot("industrial6")
+    assert "industrial6" in builtin_robots()
+    assert robot.n == 6 and robot.model.nq == 6
+    assert robot.sphere_radius.shape == (len(robot.sphere_link),)
+    assert load_robot("industrial6") is robot  # cached: problems on one robot share one NLP shape
+
+
+def test_friction_is_viscous_plus_smooth_coulomb():
+    robot = load_robot("industrial6")
+    qd = np.linspace(-1, 1, 6)
+    expected = robot.viscous * qd + robot.coulomb * np.tanh(qd / robot.friction_smoothing)
+    np.testing.assert_allclose(robot.friction(qd), expected)
+    h = 1e-7
+    np.testing.assert_allclose(robot.friction_slope(qd), (robot.friction(qd + h) - robot.friction(qd - h)) / (2 * h),
+                               rtol=1e-5)
+
+
+def test_custom_files_relative_to_base_dir(tmp_path):
+    (tmp_path / "robot.urdf").write_text((SPEC.parent / "robot.urdf").read_text())
+    write_spec(tmp_path / "spec.yaml", name="copy")
+    robot = load_robot({"urdf": "robot.urdf", "spec": "spec.yaml"}, base_dir=tmp_path)
+    assert robot.name == "copy"
+
+
+def test_ur5_from_example_robot_data_with_a_spec_of_its_own(tmp_path):
+    spec = {"name": "ur5", "joints": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+                                      "wrist_2_joint", "wrist_3_joint"],
+            "limits": {"position": {"lower": [-6.28] * 6, "upper": [6.28] * 6}, "velocity": [3.14] * 6,
+                       "torque": [150, 150, 150, 28, 28, 28], "torque_rate": [1500] * 6},
+            "gear_ratios": [100] * 6, "friction": {"viscous": [0.1] * 6, "coulomb": [1] * 6, "smoothing": 0.05},
+            "spheres": [{"link": "forearm_link", "center": [0, 0, 0.2], "radius": 0.06}], "self_collision": []}
+    (tmp_path / "ur5.yaml").write_text(yaml.safe_dump(spec))
+    robot = load_robot({"urdf": str(example_robot_urdf("ur5")), "spec": str(tmp_path / "ur5.yaml")})
+    assert robot.n == 6 and robot.sphere_joint.tolist() == [3]
+
+
+def test_missing_file_is_named(tmp_path):
+    with pytest.raises(RobotError, match="robot file not found: .*nothing.urdf"):
+        load_robot({"urdf": str(tmp_path / "nothing.urdf"), "spec": str(SPEC)})
+
+
+@pytest.mark.parametrize("changes, message", [
+    ({"joints": ["joint_1", "bogus"]}, r"joints not in the URDF: \['bogus'\]"),
+    ({"joints": ["joint_2", "joint_1"]}, "must follow the URDF tree order"),
+    ({"gear_ratios": [1, 2]}, "'gear_ratios' needs 6 values"),
+    ({"spheres": [{"link": "nowhere", "center": [0, 0, 0], "radius": 0.1}]}, "unknown link 'nowhere'"),
+    ({"self_collision": [[0, 99]]}, "self_collision index outside"),
+    ({"friction": {"viscous": [0] * 6, "coulomb": [0] * 6, "smoothing": 0}}, "smoothing must be > 0"),
+])
+def test_broken_spec_is_explained(tmp_path, changes, message):
+    write_spec(tmp_path / "spec.yaml", **changes)
+    with pytest.raises(RobotError, match=message):
+        load_robot({"urdf": str(SPEC.parent / "robot.urdf"), "spec": str(tmp_path / "spec.yaml")})
+
+
+def test_robot_must_be_name_or_files():
+    with pytest.raises(RobotError, match="built-in name or"):
+        load_robot({"urdf": "x"})

@@ -1,0 +1,140 @@
+"""Scenario loading and validation: every user mistake gets a specific ScenarioError/RobotError."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+import yaml
+from helpers import REPO
+
+from ocpkit import load_scenario
+from ocpkit.errors import RobotError, ScenarioError
+from ocpkit.scenario import problem_from_dict
+
+CASE1 = REPO / "scenarios/paper/case1.yaml"
+
+
+@pytest.fixture
+def case1() -> dict:
+    return yaml.safe_load(CASE1.read_text())
+
+
+def load(data: dict):
+    return problem_from_dict(copy.deepcopy(data), base_dir=REPO)
+
+
+def test_paper_cases_load_in_radians(case1):
+    problem = load_scenario(CASE1)
+    np.testing.assert_allclose(problem.start, np.radians(case1["start"]))
+    assert problem.name == "case1" and problem.mu == 0.3 and problem.scene.n_obstacles == 1
+    assert problem.time.guess == 10.0
+
+
+def test_unit_rad_is_taken_as_is(case1):
+    case1["unit"], case1["start"], case1["goal"] = "rad", np.radians(case1["start"]).tolist(), np.radians(case1["goal"]).tolist()
+    np.testing.assert_allclose(load(case1).start, load_scenario(CASE1).start)
+
+
+def test_malformed_yaml(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("robot: industrial6\nstart: [0, 0\n")
+    with pytest.raises(ScenarioError, match="malformed YAML"):
+        load_scenario(bad)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ScenarioError, match="cannot read scenario"):
+        load_scenario(tmp_path / "nope.yaml")
+
+
+def test_unknown_robot(case1):
+    case1["robot"] = "robby"
+    with pytest.raises(RobotError, match="unknown robot 'robby'.*industrial6"):
+        load(case1)
+
+
+@pytest.mark.parametrize("key", ["unit", "start", "goal", "robot"])
+def test_missing_key(case1, key):
+    del case1[key]
+    with pytest.raises(ScenarioError, match=f"missing '{key}'"):
+        load(case1)
+
+
+def test_unknown_key_is_named(case1):
+    case1["obstacles"] = []
+    with pytest.raises(ScenarioError, match="unknown keys \\['obstacles'\\]"):
+        load(case1)
+
+
+def test_wrong_vector_length(case1):
+    case1["goal"] = [0, 0, 0]
+    with pytest.raises(ScenarioError, match="'goal' needs shape \\(6,\\)"):
+        load(case1)
+
+
+def test_bad_unit(case1):
+    case1["unit"] = "grad"
+    with pytest.raises(ScenarioError, match="unit must be 'deg' or 'rad'"):
+        load(case1)
+
+
+def test_start_outside_limits_names_the_joint(case1):
+    case1["start"][4] = -130
+    with pytest.raises(ScenarioError, match=r"start: joint 5 \(joint_5\) = -130.00 deg is outside \[-120.00, 100.00\]"):
+        load(case1)
+
+
+def test_start_exactly_at_a_limit_is_accepted(case1):
+    case1["start"][4] = -120
+    assert load(case1).start[4] == pytest.approx(np.radians(-120))
+
+
+def test_goal_in_obstacle_names_the_sphere(case1):
+    case1["scene"]["obstacles"][0]["sphere"]["center"] = [0.4, 1.09, 0.6]  # at the place position
+    with pytest.raises(ScenarioError, match=r"goal configuration is in collision: sphere \d+ \(link_\d\) overlaps obstacle 0"):
+        load(case1)
+
+
+def test_self_collision_names_the_pair(case1):
+    case1["start"] = [0, 0, 200, 0, 0, 0]  # forearm folded back onto the upper arm
+    with pytest.raises(ScenarioError, match=r"self-collision: sphere \d+ \(link_\d\) and sphere \d+ \(link_\d\)"):
+        load(case1)
+
+
+def test_start_outside_workspace_names_the_face(case1):
+    case1["scene"]["workspace"]["max"][2] = 1.0
+    with pytest.raises(ScenarioError, match="leaves the workspace at z max"):
+        load(case1)
+
+
+def test_impossible_time_bounds(case1):
+    case1["time"] = {"min": 0.1, "max": 0.3, "guess": 0.3}
+    with pytest.raises(ScenarioError, match="below the velocity-limited minimum"):
+        load(case1)
+
+
+@pytest.mark.parametrize("time, message", [({"min": 2, "max": 1}, "0 < min ≤ max"),
+                                           ({"min": 1, "max": 5, "guess": 9}, "time.guess")])
+def test_inconsistent_time_bounds(case1, time, message):
+    case1["time"] = time
+    with pytest.raises(ScenarioError, match=message):
+        load(case1)
+
+
+def test_obstacle_needs_positive_radius(case1):
+    case1["scene"]["obstacles"][0]["sphere"]["radius"] = -0.1
+    with pytest.raises(ScenarioError, match="radius must be > 0"):
+        load(case1)
+
+
+def test_workspace_min_below_max(case1):
+    case1["scene"]["workspace"]["min"][0] = 5.0
+    with pytest.raises(ScenarioError, match="min .* must be below max"):
+        load(case1)
+
+
+def test_scenario_must_be_a_mapping():
+    with pytest.raises(ScenarioError, match="must be a mapping"):
+        problem_from_dict([1, 2, 3])

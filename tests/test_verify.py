@@ -1,0 +1,68 @@
+"""verify on hand-made trajectories: each kind of violation is caught, a clean motion passes."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from helpers import REPO
+
+from ocpkit import load_scenario, verify
+from ocpkit.trajectory import Samples, Trajectory
+
+PROBLEM = load_scenario(REPO / "scenarios/paper/case2.yaml")
+
+
+def quintic(problem, tf: float, tau_offset: float = 0.0) -> Trajectory:
+    """Rest-to-rest minimum-jerk motion start → goal in tf seconds, with its exact inverse-dynamics torque."""
+    robot, delta = problem.robot, problem.goal - problem.start
+    data = robot.model.createData()
+
+    def at(t: np.ndarray) -> Samples:
+        x = np.clip(np.asarray(t) / tf, 0, 1)[:, None]
+        s, ds, dds = 10 * x**3 - 15 * x**4 + 6 * x**5, (30 * x**2 - 60 * x**3 + 30 * x**4) / tf, (60 * x - 180 * x**2 + 120 * x**3) / tf**2
+        q, qd, qdd = problem.start + s * delta, ds * delta, dds * delta
+        tau = np.array([pin.rnea(robot.model, data, *row).copy() for row in zip(q, qd, qdd)]) + robot.friction(qd)
+        return Samples(np.asarray(t), q, qd, qdd, tau + tau_offset, np.gradient(tau, np.asarray(t), axis=0))
+
+    return Trajectory(at(np.array([0.0, tf])), at)
+
+
+def by_name(verification):
+    return {c.name: c for c in verification.checks}
+
+
+def test_slow_motion_is_clean_except_through_the_obstacle():
+    checks = by_name(verify(PROBLEM, quintic(PROBLEM, 4.0)))
+    assert all(checks[k].ok for k in ("position", "velocity", "torque", "torque_rate", "dynamics", "boundary"))
+    assert not checks["obstacle"].ok  # case 2's obstacle sits on the straight joint-space path
+    assert checks["obstacle"].worst > 0.01
+
+
+def test_without_obstacles_a_slow_motion_verifies():
+    free = dataclasses.replace(PROBLEM, scene=dataclasses.replace(PROBLEM.scene, obstacle_centers=np.zeros((0, 3)),
+                                                                  obstacle_radii=np.zeros(0)))
+    result = verify(free, quintic(free, 4.0))
+    assert result.ok, result.summary()
+    assert len(result.violation_times) == 0
+
+
+def test_too_fast_motion_breaks_velocity_and_torque_limits():
+    result = verify(PROBLEM, quintic(PROBLEM, 0.3))
+    checks = by_name(result)
+    assert not checks["velocity"].ok and not checks["torque"].ok
+    assert 0 < checks["velocity"].time < 0.3
+    assert len(result.violation_times) > 0
+
+
+def test_torque_that_does_not_match_the_motion_fails_dynamics():
+    checks = by_name(verify(PROBLEM, quintic(PROBLEM, 4.0, tau_offset=30.0)))
+    assert not checks["dynamics"].ok
+    assert checks["dynamics"].worst == pytest.approx(30.0 / (2 * PROBLEM.robot.tau_max).min(), rel=1e-6)
+
+
+def test_wrong_goal_fails_boundary():
+    moved = dataclasses.replace(PROBLEM, goal=PROBLEM.goal + 0.01)
+    assert not by_name(verify(moved, quintic(PROBLEM, 4.0)))["boundary"].ok
