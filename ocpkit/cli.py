@@ -48,7 +48,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--planner", default="simultaneous")
     p.add_argument("--transcription", default="chebyshev")
     p.add_argument("--knots", type=int, default=12, help="number of knot intervals N (default 12)")
-    p.add_argument("--dynamics", default="casadi")
+    p.add_argument("--dynamics", default="casadi-rnea", help="casadi-rnea (default, inverse form) or casadi (ABA)")
     p.add_argument("--solver", default="ipopt")
     p.add_argument("--mu", type=float, default=None, help="jerk weight μ (default: the scenario's)")
     p.add_argument("-o", "--output", help="write the trajectory JSON here")

@@ -17,15 +17,16 @@ from ocpkit.scene import Scene
 
 
 def sphere_centers(robot: Robot, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
-    """World positions of the robot's spheres at configurations q (n,) or (K, n): shape (M, 3) or (K, M, 3)."""
+    """World positions of the robot's spheres at configurations q (n,) or (K, n): shape (M, 3) or (K, M, 3).
+
+    Pass a `data` (robot.model.createData()) when calling often: creating one costs more than the kinematics."""
     data = data or robot.model.createData()
-    joints, index = np.unique(robot.sphere_joint, return_inverse=True)
     qs = np.atleast_2d(q)
-    poses = np.empty((len(qs), len(joints), 4, 4))  # homogeneous world pose of every sphere-carrying joint
+    poses = np.empty((len(qs), robot.model.njoints, 4, 4))  # homogeneous world pose of every joint
     for k, qk in enumerate(qs):
         pin.forwardKinematics(robot.model, data, qk)
-        poses[k] = [data.oMi[j].homogeneous for j in joints.tolist()]
-    sphere_poses = poses[:, index]
+        poses[k] = [placement.homogeneous for placement in data.oMi]
+    sphere_poses = poses[:, robot.sphere_joint]
     out = np.einsum("kmij,mj->kmi", sphere_poses[..., :3, :3], robot.sphere_offset) + sphere_poses[..., :3, 3]
     return out[0] if np.ndim(q) == 1 else out
 

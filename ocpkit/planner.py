@@ -78,7 +78,7 @@ def plan(problem: Problem, planner: str = "simultaneous", **options: Any) -> Pla
     return PLANNERS.get(planner)(problem, **options)
 
 
-def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str = "casadi",
+def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str = "casadi-rnea",
                       solver: str = "ipopt", guess: np.ndarray | None = None, refinements: int = 3,
                       transcription_options: dict | None = None, solver_options: dict | None = None) -> Plan:
     """Path and timing together as one optimal control problem (the paper's method).

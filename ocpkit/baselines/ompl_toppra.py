@@ -1,0 +1,379 @@
+"""The path–velocity decomposition baseline: an OMPL joint-space path, made smooth, then timed by TOPP-RA.
+
+The classic alternative to planning path and timing together, on the same problems and checked by the same
+dense `verify`. Each step is one function below:
+
+1. `FreeSpace`: OMPL's validity test is the verifier's own collision model (`geometry.sphere_centers`,
+   `geometry.clearances`: robot spheres against each other, the obstacle spheres and the workspace box):
+   a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 as in the Chebyshev transcription).
+   The joint limits are the state-space bounds.
+2. `_ompl_path`: RRTConnect (or RRT*, BIT*, PRM) in joint space. A straight segment is checked, batched, at
+   configurations at most `resolution` rad apart (Euclidean over the joints). OMPL's PathSimplifier then
+   shortens the path until it stops improving.
+3. `_smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
+   tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
+   obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
+4. `_time_optimal`: TOPP-RA on `grid_points` path points, with joint velocity limits and joint torque limits
+   tau = rnea(q, qd, qdd) + friction(qd).
+5. `_TimedPath`: the resulting trajectory q(t) = path(s(t)), and the torque it takes.
+
+Choices and what they cost, stated plainly:
+
+- Zero end tangents ('clamped'). Along a path, qdd = q'(s) s̈ + q''(s) ṡ². The problem asks for rest at both
+  ends, qd = qdd = 0, and a time-optimal s̈ is not zero at the ends. So only a path with q'(0) = q'(1) = 0
+  starts and stops with qdd = 0. A 'natural' spline gives qdd(0) = q'(0) s̈(0) ≠ 0 and fails the boundary check.
+- Constant s̈ between grid points (toppra's ParametrizeConstAccel, not its default spline refit). The motion
+  stays exactly on the collision-checked path, and the limits hold where TOPP-RA imposed them. The default
+  refits a spline in time through the grid points, which leaves the path and overshoots the torque limit
+  near the clamped ends.
+- Friction. TOPP-RA's constraints are linear in (s̈, ṡ²). The friction law viscous·qd + coulomb·tanh(qd/ε)
+  depends on ṡ, so it enters as toppra's path-dependent term, evaluated at an assumed speed profile. The
+  first pass assumes every moving joint is at its velocity limit (the largest friction). The second pass
+  uses the speed the first pass found (`FRICTION_PASSES`). The friction is then right at the grid points to
+  the extent the profile stopped changing. `verify` checks the exact model.
+- Limits hold on TOPP-RA's grid: at both ends of every grid interval, for the velocity at the grid points.
+  Between grid points the path's curvature changes slightly, so `grid_points` must be large enough.
+- TOPP-RA cannot bound torque rate or jerk. The time-optimal s̈ is bang–bang and piecewise constant on the
+  grid, so the torque jumps. The torque rate reported is the mean rate over a `TORQUE_RATE_WINDOW` (1 ms)
+  window centred at t: the derivative where the torque is smooth, and J / 1 ms across a jump J, which is
+  what a 1 kHz servo loop would have to follow. The baseline normally fails the torque-rate check; the plan
+  says so in its status ("violated").
+
+OMPL and toppra are optional dependencies, imported on first use (toppra alone takes about 1 s to import).
+"""
+
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any, Iterator
+
+import numpy as np
+import pinocchio as pin
+
+from ocpkit.errors import RegistryError
+from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.planner import PLANNERS, Plan, PlanStats
+from ocpkit.problem import Problem
+from ocpkit.robots import Robot
+from ocpkit.scenario import validate
+from ocpkit.trajectory import Samples, Trajectory
+from ocpkit.transcription.base import NLP
+from ocpkit.verify import verify
+
+OMPL_PLANNERS = {"rrtconnect": "RRTConnect", "rrtstar": "RRTstar", "bitstar": "BITstar", "prm": "PRM"}
+REPAIR_ROUNDS = 8
+FRICTION_PASSES = 2
+TORQUE_RATE_WINDOW = 1e-3  # s
+SEGMENT_BATCH = 16  # configurations per batched collision check along a segment, the first batch
+
+
+class FreeSpace:
+    """The verifier's collision model as a yes/no test: free iff every clearance is ≥ `margin` (m).
+
+    Keeps one pinocchio Data and counts the configurations it has checked (`checks`)."""
+
+    def __init__(self, problem: Problem, margin: float) -> None:
+        self.robot, self.scene, self.margin = problem.robot, problem.scene, margin
+        self.data = problem.robot.model.createData()
+        self.checks = 0
+
+    def clearance(self, q: np.ndarray) -> np.ndarray:
+        """Smallest clearance (m) at each configuration of q (K, n): shape (K,); +inf if there is nothing to hit."""
+        c = clearances(self.robot, self.scene, sphere_centers(self.robot, q, self.data))
+        self.checks += len(q)
+        flat = [values.reshape(len(q), -1) for values in (c.self_pairs, c.obstacles, c.workspace)]
+        return np.concatenate(flat, axis=1).min(axis=1, initial=np.inf)
+
+    def free(self, q: np.ndarray) -> np.ndarray:
+        """Whether each configuration of q (K, n) keeps the margin: shape (K,), bool."""
+        return self.clearance(q) >= self.margin
+
+    def segment_free(self, a: np.ndarray, b: np.ndarray, resolution: float) -> bool:
+        """Whether the straight segment a → b (n,) is free at configurations at most `resolution` rad apart.
+
+        b is checked, a is not (OMPL has already checked it). The configurations are checked coarse to fine,
+        in batches that double in size, so a collision usually stops the check after the first batch."""
+        count = max(int(np.ceil(np.linalg.norm(b - a) / resolution)), 1)
+        order = _coarse_to_fine(count) / count
+        done, size = 0, SEGMENT_BATCH
+        while done < count:
+            if not self.free(a + np.outer(order[done:done + size], b - a)).all():
+                return False
+            done, size = done + size, 2 * size
+        return True
+
+
+def _coarse_to_fine(count: int) -> np.ndarray:
+    """The indices 1..count: count first, then the others by decreasing power of two dividing them."""
+    inner = np.arange(1, count)
+    return np.concatenate([[count], inner[np.argsort(-(inner & -inner), kind="stable")]])
+
+
+# -- OMPL ---------------------------------------------------------------------------------------------
+
+
+@contextmanager
+def _ompl_log_level(util: Any, level: Any) -> Iterator[None]:
+    """Run a block at OMPL log `level`, then restore the previous level."""
+    previous = util.getLogLevel()
+    util.setLogLevel(level)
+    try:
+        yield
+    finally:
+        util.setLogLevel(previous)
+
+
+def _seed_ompl(util: Any, seed: int) -> None:
+    """Seed OMPL's RNG with seed + 1 (OMPL rejects 0). Every RNG created afterwards (planner, sampler,
+    simplifier) then draws from it, so a run repeats exactly. OMPL logs an error when it is re-seeded after
+    first use, although the new seed does take effect; that message is silenced."""
+    with _ompl_log_level(util, util.LOG_NONE):
+        util.RNG.setSeed(seed + 1)
+
+
+def _space_information(problem: Problem, free: FreeSpace, resolution: float) -> Any:
+    """OMPL's joint space: the joint limits as bounds, `free` as the state validity checker, and straight
+    segments checked by `free.segment_free` at `resolution` rad."""
+    import ompl.base as ob
+
+    robot, n = problem.robot, problem.robot.n
+    space = ob.RealVectorStateSpace(n)
+    bounds = ob.RealVectorBounds(n)
+    bounds.low, bounds.high = robot.q_lower.tolist(), robot.q_upper.tolist()
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+
+    class SegmentValidator(ob.MotionValidator):
+        def checkMotion(self, a: Any, b: Any) -> bool:  # noqa: N802  (OMPL's name)
+            return free.segment_free(_vector(a, n), _vector(b, n), resolution)
+
+    si.setStateValidityChecker(lambda state: bool(free.free(_vector(state, n)[None])[0]))
+    si.setMotionValidator(SegmentValidator(si))
+    si.setup()
+    return si
+
+
+def _vector(state: Any, n: int) -> np.ndarray:
+    """An OMPL real-vector state as an array (n,)."""
+    return np.array(state[0:n])
+
+
+def _state(si: Any, q: np.ndarray) -> Any:
+    """A new OMPL state holding q (n,), clipped into the joint limits (scenario files allow 1e-9 rad of round-off)."""
+    bounds = si.getStateSpace().getBounds()
+    state = si.allocState()
+    state[0:len(q)] = np.clip(q, bounds.low, bounds.high).tolist()
+    return state
+
+
+@dataclass(frozen=True)
+class _OmplResult:
+    """Simplified waypoints (k, n) from start to goal, or None without an exact path; times in seconds."""
+
+    waypoints: np.ndarray | None
+    path_time: float
+    simplify_time: float
+
+
+def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
+               resolution: float, max_checks: int | None) -> _OmplResult:
+    """Plan start → goal with the named OMPL planner until it has an exact path or the budget ends
+    (`planning_time` seconds, or `max_checks` checked configurations), then simplify the path to convergence."""
+    import ompl.base as ob
+    import ompl.geometric as og
+    import ompl.util as ou
+
+    with _ompl_log_level(ou, ou.LOG_ERROR):
+        _seed_ompl(ou, seed)
+        si = _space_information(problem, free, resolution)
+        setup = og.SimpleSetup(si)
+        setup.setStartAndGoalStates(_state(si, problem.start), _state(si, problem.goal))
+        setup.setPlanner(getattr(og, OMPL_PLANNERS[planner_name])(si))
+        start = time.perf_counter()
+        deadline = start + planning_time
+        setup.solve(ob.PlannerTerminationCondition(
+            lambda: time.perf_counter() > deadline or (max_checks is not None and free.checks >= max_checks)))
+        path_time = time.perf_counter() - start
+        if not setup.haveExactSolutionPath():
+            return _OmplResult(None, path_time, 0.0)
+        path = og.PathGeometric(setup.getSolutionPath())
+        og.PathSimplifier(si).simplifyMax(path)
+        waypoints = np.array([_vector(state, problem.robot.n) for state in path.getStates()])
+        return _OmplResult(waypoints, path_time, time.perf_counter() - start - path_time)
+
+
+# -- smooth path --------------------------------------------------------------------------------------
+
+
+def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float) -> tuple[Any, int]:
+    """A clamped cubic spline through `waypoints` (k, n), parametrised by chord length (rad), that keeps half
+    the margin at checks every resolution/4 rad; returns (toppra path, repair rounds used).
+
+    After the last round the spline is returned as it is; `verify` then reports any contact."""
+    from toppra.interpolator import SplineInterpolator
+
+    waypoints = waypoints[np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 0])]
+    for rounds in range(REPAIR_ROUNDS + 1):
+        chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
+        path = SplineInterpolator(chord, waypoints, bc_type="clamped")
+        checks = np.linspace(0.0, chord[-1], int(np.ceil(4 * chord[-1] / resolution)) + 1)
+        bad = checks[free.clearance(path(checks)) < free.margin / 2]
+        if not len(bad) or rounds == REPAIR_ROUNDS:
+            break
+        segments = np.unique(np.clip(np.searchsorted(chord, bad) - 1, 0, len(chord) - 2))
+        waypoints = np.insert(waypoints, segments + 1, (waypoints[segments] + waypoints[segments + 1]) / 2, axis=0)
+    return path, rounds
+
+
+# -- TOPP-RA ------------------------------------------------------------------------------------------
+
+
+def _time_optimal(problem: Problem, path: Any, grid_points: int) -> tuple[Any, np.ndarray] | None:
+    """TOPP-RA's time-optimal rest-to-rest timing of `path` under joint velocity and torque limits (with the
+    friction passes described in the module docstring): toppra's ParametrizeConstAccel trajectory and the
+    times (s) of its grid points, or None if the path cannot be timed within the limits."""
+    import toppra.algorithm
+    import toppra.constraint
+
+    robot = problem.robot
+    data = robot.model.createData()
+    grid = np.linspace(*path.path_interval, grid_points)
+    tangent = path(grid, 1)
+    velocity = toppra.constraint.JointVelocityConstraint(robot.qd_max)
+    bounds = (np.vstack([np.eye(robot.n), -np.eye(robot.n)]), np.concatenate([robot.tau_max, robot.tau_max]))
+    qd = robot.qd_max * np.sign(tangent)  # first pass: every moving joint at its velocity limit
+    for _ in range(FRICTION_PASSES):
+        friction = robot.friction(qd)
+        torque = toppra.constraint.SecondOrderConstraint(
+            lambda q, v, a: pin.rnea(robot.model, data, q, v, a).copy(), lambda _q: bounds[0], lambda _q: bounds[1],
+            robot.n, custom_term=lambda _path, s, friction=friction: friction[np.searchsorted(grid, s)],
+            discretization_scheme=toppra.constraint.DiscretizationType.Interpolation)
+        algorithm = toppra.algorithm.TOPPRA([velocity, torque], path, gridpoints=grid, solver_wrapper="seidel",
+                                            parametrizer="ParametrizeConstAccel")
+        motion = algorithm.compute_trajectory(0.0, 0.0)
+        if motion is None:
+            return None
+        speed = algorithm.problem_data.sd_vec
+        qd = tangent * speed[:, None]
+    return motion, _grid_times(grid, speed)
+
+
+def _grid_times(grid: np.ndarray, speed: np.ndarray) -> np.ndarray:
+    """Times (s) at the path points `grid` passed at path speeds `speed` under constant s̈ in between."""
+    return np.concatenate([[0.0], np.cumsum(2.0 * np.diff(grid) / (speed[:-1] + speed[1:]))])
+
+
+@dataclass(frozen=True)
+class _TimedPath:
+    """q(t) = path(s(t)) from toppra's trajectory (eval/evald/evaldd), tau = rnea + friction, and the torque
+    rate as the mean over TORQUE_RATE_WINDOW (see the module docstring). Before 0 and after t_f the robot rests."""
+
+    motion: Any
+    robot: Robot
+    data: pin.Data
+
+    def __call__(self, t: np.ndarray) -> Samples:
+        t = np.asarray(t, dtype=float)
+        q, qd, qdd, tau = self._state(t)
+        half = TORQUE_RATE_WINDOW / 2
+        taud = (self._state(t + half)[3] - self._state(t - half)[3]) / TORQUE_RATE_WINDOW
+        return Samples(t, q, qd, qdd, tau, taud)
+
+    def _state(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """q, qd, qdd, tau at times t (m,), each (m, n)."""
+        t = np.clip(t, *self.motion.path_interval)
+        q, qd, qdd = self.motion.eval(t), self.motion.evald(t), self.motion.evaldd(t)
+        model, data = self.robot.model, self.data
+        rigid = np.array([pin.rnea(model, data, *row).copy() for row in zip(q, qd, qdd)])
+        return q, qd, qdd, rigid + self.robot.friction(qd)
+
+
+def _hold(problem: Problem) -> Trajectory:
+    """Standing still at the start for time.min seconds: what a plan without a trajectory leaves the robot doing."""
+    robot = problem.robot
+    gravity = pin.rnea(robot.model, robot.model.createData(), problem.start, np.zeros(robot.n), np.zeros(robot.n))
+
+    def still(t: np.ndarray) -> Samples:
+        t = np.asarray(t, dtype=float)
+        zeros = np.zeros((len(t), robot.n))
+        return Samples(t, np.tile(problem.start, (len(t), 1)), zeros, zeros, np.tile(gravity, (len(t), 1)), zeros)
+
+    return Trajectory(still(np.array([0.0, problem.time.min])), still)
+
+
+def _import_backends() -> float:
+    """Import OMPL and toppra; the seconds it took (the one-time set-up, about 1 s; 0 once imported)."""
+    start = time.perf_counter()
+    import ompl.geometric  # noqa: F401
+    import toppra.algorithm  # noqa: F401
+
+    return time.perf_counter() - start
+
+
+# -- the planner --------------------------------------------------------------------------------------
+
+
+def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
+                     resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
+                     max_checks: int | None = None, **_ignored: Any) -> Plan:
+    """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (see the module docstring).
+
+    `planner_name`: one of OMPL_PLANNERS. `planning_time` (s): OMPL's budget; RRTConnect and PRM stop at their
+    first path, so with the same `seed` they repeat exactly; RRT* and BIT* improve until the budget ends, so
+    give them `max_checks` (checked configurations) instead to make them repeat. `resolution` (rad): spacing
+    of collision checks along straight joint-space segments. `grid_points`: TOPP-RA's path discretization.
+    `margin` (m): clearance kept while planning, lowered to the start's or goal's clearance if that is smaller.
+    Options for other planners (knots, solver, ...) are ignored.
+
+    Status: "verified" or "violated" (dense `verify`), "no_path" (OMPL found no exact path in its budget) or
+    "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start."""
+    if planner_name not in OMPL_PLANNERS:
+        raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
+    setup = _import_backends()
+    began = time.perf_counter()
+    validate(problem)
+    ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
+    free = FreeSpace(problem, min(margin, float(ends.min())))
+    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks)
+    extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
+             "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,
+             "margin_m": free.margin}
+    method = {"planner": "ompl-toppra", "transcription": "toppra", "knots": grid_points, "dynamics": "pinocchio",
+              "solver": planner_name}
+
+    def finish(trajectory: Trajectory, status: str | None, message: str) -> Plan:
+        """The Plan; status None means "verified" or "violated", as the dense verification says."""
+        verification = verify(problem, trajectory)
+        status = status or ("verified" if verification.ok else "violated")
+        return Plan(trajectory, status, verification,
+                    PlanStats(time.perf_counter() - began, setup, 0, 0, message, extra), method)
+
+    if found.waypoints is None:
+        return finish(_hold(problem), "no_path", f"{planner_name}: no exact path within the budget")
+    smoothing = time.perf_counter()
+    path, rounds = _smooth_path(found.waypoints, free, resolution)
+    timing = time.perf_counter()
+    timed = _time_optimal(problem, path, grid_points)
+    extra.update(smooth_time_s=timing - smoothing, toppra_time_s=time.perf_counter() - timing,
+                 validity_checks=free.checks, waypoints=len(path.ss_waypoints), repair_rounds=rounds)
+    if timed is None:
+        return finish(_hold(problem), "infeasible", "TOPP-RA: the path cannot be timed within the limits")
+    motion, knot_times = timed
+    interpolant = _TimedPath(motion, problem.robot, problem.robot.model.createData())
+    message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; "
+               f"TOPP-RA: {grid_points} grid points")
+    return finish(Trajectory(interpolant(knot_times), interpolant), None, message)
+
+
+def ompl_guess(problem: Problem, nlp: NLP, **baseline_options: Any) -> np.ndarray:
+    """A warm start for `nlp`: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`)
+    sampled on the NLP's grid by `nlp.encode`; the NLP's own guess if the baseline has no trajectory."""
+    baseline = plan_ompl_toppra(problem, **baseline_options)
+    if baseline.status in ("no_path", "infeasible"):
+        return nlp.initial_guess(problem)
+    return nlp.encode(baseline.trajectory)
+
+
+PLANNERS.register("ompl-toppra", plan_ompl_toppra)
