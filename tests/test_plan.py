@@ -87,9 +87,11 @@ def test_cli_reports_user_mistakes_in_one_line(tmp_path, capsys):
 
 def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
     shutil.copy(CASES[3], tmp_path / CASES[3].name)
-    run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1)
+    run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1, dynamics=("casadi-rnea", "casadi"))
     rows = list(csv.DictReader((tmp_path / "out/results.csv").open()))
     assert tuple(rows[0]) == RESULT_COLUMNS
-    assert [(r["case"], r["knots"], r["status"]) for r in rows] == [("case4", "12", "verified"), ("case4", "8", "verified")]
+    assert [(r["dynamics"], r["knots"], r["status"]) for r in rows] == [
+        ("casadi-rnea", "12", "verified"), ("casadi-rnea", "8", "verified"),
+        ("casadi", "12", "verified"), ("casadi", "8", "verified")]
     assert (tmp_path / "out/trajectories/case4-simultaneous-chebyshev-12.json").exists()
     assert "one-time set-up" in capsys.readouterr().out
