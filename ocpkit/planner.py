@@ -3,7 +3,9 @@
 The simultaneous planner (transcription + dynamics + solver) builds one NLP per problem shape and caches
 it with its prepared solver, so a second query of the same shape pays no set-up. After each solve the
 trajectory is verified densely; where a path constraint is violated between check times, the adaptive
-check slots are moved there and the NLP is re-solved warm-started, for at most `refinements` rounds.
+check slots are moved there, the clearance margin grows by twice the deepest contact found, and the NLP is
+re-solved warm-started (no rebuild), for at most `refinements` rounds. A check at the worst time alone
+rarely suffices: with the constraint active, the polynomial then dips just beside the new check.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from ocpkit.problem import Problem
 from ocpkit.registry import Registry
 from ocpkit.solvers.base import SOLVERS, Solver, SolverStatus
 from ocpkit.trajectory import Trajectory
-from ocpkit.transcription.base import NLP, TRANSCRIPTIONS
+from ocpkit.transcription.base import NLP, TRANSCRIPTIONS, Refinement
 from ocpkit.verify import Verification, verify
 
 PLANNERS: Registry[Any] = Registry("planner", "ocpkit.planners")
@@ -90,17 +92,18 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
                                       {"knots": knots, **(transcription_options or {})}, solver_options or {})
     bounds = nlp.bounds(problem)
     w = nlp.initial_guess(problem) if guess is None else guess
-    fractions = np.zeros(0)
+    refinement = Refinement()
     iterations, rounds = 0, 0
     while True:
-        result = nlp_solver.solve(nlp, w, nlp.parameters(problem, fractions), bounds)
+        result = nlp_solver.solve(nlp, w, nlp.parameters(problem, refinement), bounds)
         iterations += result.iterations
         trajectory = nlp.decode(result.w)
         verification = verify(problem, trajectory)
         fresh = verification.violation_times / trajectory.tf
         if verification.ok or result.status != SolverStatus.CONVERGED or rounds >= refinements or not len(fresh):
             break
-        fractions = np.concatenate([fresh, fractions])  # newest violations take the slots first
+        refinement = Refinement(np.concatenate([fresh, refinement.check_fractions]),  # newest take the slots
+                                refinement.extra_margin + 2.0 * verification.penetration)
         w, rounds = result.w, rounds + 1
     if result.status != SolverStatus.CONVERGED:
         status = result.status.value

@@ -28,6 +28,7 @@ LIMIT_TOLERANCE = 0.01
 DYNAMICS_TOLERANCE = 0.01
 GEOMETRY_TOLERANCE = 0.0
 BOUNDARY_TOLERANCE = 1e-6
+GEOMETRY_CHECKS = ("self_collision", "obstacle", "workspace")
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,11 @@ class Verification:
         return all(c.ok for c in self.checks)
 
     @property
+    def penetration(self) -> float:
+        """Deepest sphere contact of any kind (m), 0 if there is none."""
+        return max([0.0] + [c.worst for c in self.checks if c.name in GEOMETRY_CHECKS])
+
+    @property
     def worst(self) -> Check:
         """The check furthest beyond (or closest to) its tolerance."""
         return max(self.checks, key=lambda c: c.worst - c.tolerance)
@@ -83,7 +89,7 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
     }
     consistency = np.abs(samples.tau - tau_needed) / (2.0 * robot.tau_max)
     c = clearances(robot, problem.scene, sphere_centers(robot, samples.q))
-    penetration = {"self_collision": -c.self_pairs, "obstacle": -c.obstacles, "workspace": -c.workspace}
+    penetration = dict(zip(GEOMETRY_CHECKS, (-c.self_pairs, -c.obstacles, -c.workspace)))
     checks = [_worst(name, v, LIMIT_TOLERANCE, samples.t, "rel") for name, v in excess.items()]
     checks.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))
     checks += [_worst(name, v, GEOMETRY_TOLERANCE, samples.t, "m") for name, v in penetration.items()]

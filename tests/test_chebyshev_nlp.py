@@ -13,6 +13,7 @@ from test_verify import quintic
 
 from ocpkit import load_scenario
 from ocpkit.transcription import TRANSCRIPTIONS
+from ocpkit.transcription.base import Refinement
 
 PROBLEM = load_scenario(REPO / "scenarios/paper/case2.yaml")
 KNOTS = 6  # a quintic has degree 5 ≤ N, so the Chebyshev interpolant reproduces it exactly
@@ -95,5 +96,14 @@ def test_moved_obstacle_changes_the_parameters_not_the_nlp(nlp):
 
 
 def test_check_fractions_move_the_adaptive_slots(nlp):
-    default, moved = nlp.parameters(PROBLEM), nlp.parameters(PROBLEM, np.array([0.5]))
+    default, moved = nlp.parameters(PROBLEM), nlp.parameters(PROBLEM, Refinement(np.array([0.5])))
     assert default.shape == moved.shape and not np.allclose(default, moved)
+
+
+def test_extra_margin_tightens_the_clearance_rows(nlp):
+    w = nlp.encode(quintic(PROBLEM, 2.0))
+    f = ca.Function("g", [nlp.x, nlp.p], [nlp.g])
+    g0 = np.asarray(f(w, nlp.parameters(PROBLEM))).ravel()
+    g1 = np.asarray(f(w, nlp.parameters(PROBLEM, Refinement(extra_margin=0.02)))).ravel()
+    changed = ~np.isclose(g0, g1)
+    assert changed.any() and np.all(g1[changed] < g0[changed])

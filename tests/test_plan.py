@@ -96,3 +96,13 @@ def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
     assert (tmp_path / "out/trajectories/case4-simultaneous-chebyshev-12.json").exists()
     printed = capsys.readouterr().out
     assert "motion time t_f" in printed and "paper set-up" in printed and "machine:" in printed
+
+
+def test_refinement_repairs_contact_between_check_times():
+    problem = ocpkit.load_scenario(CASES[1])
+    no_margin = {"margin": 0.0}
+    unrefined = ocpkit.plan(problem, knots=8, refinements=0, transcription_options=no_margin)
+    assert unrefined.status == "violated" and unrefined.verification.penetration > 0
+    refined = ocpkit.plan(problem, knots=8, transcription_options=no_margin)
+    assert refined.ok and refined.stats.rounds >= 1
+    assert refined.stats.setup_time == 0.0  # the same NLP, re-solved: refinement needs no rebuild

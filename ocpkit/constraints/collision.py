@@ -6,7 +6,8 @@ Terms that can never be active are left out, which keeps the NLP (and IPOPT's KK
 every robot sphere stays within its *reach* ρ of a fixed anchor (the origin of the first joint of its
 chain, which never moves), so a sphere whose reach ball cannot touch an obstacle or a workspace face
 gets no constraint for it. Spheres on the fixed base never move at all; they are checked once, when the
-scenario is loaded (ocpkit.scenario.validate). The kept terms are part of the NLP shape (`shape_key`).
+scenario is loaded (ocpkit.scenario.validate). The kept terms are part of the NLP shape. The clearance
+margin is an NLP parameter (a refinement round may raise it), so terms are kept up to MAX_MARGIN.
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ from ocpkit.constraints.base import PointValues
 from ocpkit.dynamics.base import Dynamics
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot
+
+MAX_MARGIN = 0.1  # m: the largest clearance margin the kept collision terms stay valid for
 
 
 def sphere_reach(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
@@ -37,12 +40,13 @@ def sphere_reach(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(anchors).reshape(-1, 3), np.asarray(reach)
 
 
-def active_terms(problem: Problem, margin: float) -> tuple[np.ndarray, np.ndarray]:
-    """Boolean masks of the collision terms that can become active: obstacles (M, S), workspace faces (M, 6)."""
+def active_terms(problem: Problem) -> tuple[np.ndarray, np.ndarray]:
+    """Boolean masks of the collision terms that can become active with a margin up to MAX_MARGIN:
+    obstacles (M, S), workspace faces (M, 6)."""
     robot, scene = problem.robot, problem.scene
     anchors, reach = sphere_reach(robot)
     moving = robot.sphere_joint > 0
-    span = reach + robot.sphere_radius + margin
+    span = reach + robot.sphere_radius + MAX_MARGIN
     gaps = np.linalg.norm(anchors[:, None, :] - scene.obstacle_centers[None], axis=-1)
     obstacles = (gaps <= span[:, None] + scene.obstacle_radii[None, :]) & moving[:, None]
     if scene.workspace is None:
@@ -52,15 +56,16 @@ def active_terms(problem: Problem, margin: float) -> tuple[np.ndarray, np.ndarra
 
 
 class SphereCollision:
-    """Clearance ≥ `margin` (m) between robot spheres, to S obstacle spheres and to the workspace box."""
+    """Clearance ≥ `margin` (m, a CasADi expression, ≤ MAX_MARGIN) between robot spheres, to S obstacle
+    spheres and to the workspace box."""
 
     name = "collision"
     enforced_by_knot_bounds = False
 
-    def __init__(self, dynamics: Dynamics, problem: Problem, margin: float) -> None:
+    def __init__(self, dynamics: Dynamics, problem: Problem, margin: ca.SX) -> None:
         robot = dynamics.robot
         self.dynamics, self.margin = dynamics, margin
-        self.obstacle_mask, self.face_mask = active_terms(problem, margin)
+        self.obstacle_mask, self.face_mask = active_terms(problem)
         pairs = robot.self_collision
         self.pairs = pairs[(robot.sphere_joint[pairs] > 0).any(axis=1)] if len(pairs) else pairs
         self.obstacle_centers = ca.SX.sym("obstacle_center", problem.scene.n_obstacles, 3)

@@ -11,7 +11,7 @@ parameter vector p, so many queries of the same shape share one NLP (and one com
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -19,6 +19,15 @@ import numpy as np
 from ocpkit.problem import Problem
 from ocpkit.registry import Registry
 from ocpkit.trajectory import Trajectory
+
+
+@dataclass(frozen=True)
+class Refinement:
+    """What a refinement round may change without a rebuild: where the adaptive check slots sit (fractions
+    of t_f, newest first) and how much the clearance margin grows (m)."""
+
+    check_fractions: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    extra_margin: float = 0.0
 
 
 @dataclass
@@ -39,8 +48,8 @@ class NLP(ABC):
         """(lbx, ubx) for this problem: limits, boundary conditions, time bounds."""
 
     @abstractmethod
-    def parameters(self, problem: Problem) -> np.ndarray:
-        """The parameter vector p for this problem."""
+    def parameters(self, problem: Problem, refinement: Refinement = Refinement()) -> np.ndarray:
+        """The parameter vector p for this problem, after `refinement` (ignored where not supported)."""
 
     @abstractmethod
     def initial_guess(self, problem: Problem) -> np.ndarray:

@@ -32,12 +32,12 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.constraints import PointValues, SphereCollision, StateLimits, TorqueLimit, TorqueRateLimit
-from ocpkit.constraints.collision import active_terms
+from ocpkit.constraints.collision import MAX_MARGIN, active_terms
 from ocpkit.dynamics.base import make_dynamics
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot
 from ocpkit.trajectory import Samples, Trajectory
-from ocpkit.transcription.base import NLP, TRANSCRIPTIONS, Transcription
+from ocpkit.transcription.base import NLP, TRANSCRIPTIONS, Refinement, Transcription
 from ocpkit.transcription.polynomials import (
     clenshaw_curtis_weights, derivative_matrix, differentiation_matrix, interpolation_matrix, lobatto_points)
 
@@ -79,12 +79,13 @@ class ChebyshevNLP(NLP):
         tf = ca.SX.sym("tf")
         Q, Qd, Qdd, U = (X[k * n:(k + 1) * n, :] for k in range(4))
         tau_max = ca.DM(robot.tau_max)
-        mu = ca.SX.sym("mu")
+        mu, margin_symbol = ca.SX.sym("mu"), ca.SX.sym("margin")
+        self.margin = margin
         rows = ca.SX.sym("adaptive_rows", adaptive_checks, N + 1)  # L(s_k), one row per slot
         drows = ca.SX.sym("adaptive_drows", adaptive_checks, N + 1)  # d/ds L(s_k)
 
         self.constraints = [StateLimits(robot), TorqueLimit(robot), TorqueRateLimit(robot),
-                            SphereCollision(self.dynamics, problem, margin)]
+                            SphereCollision(self.dynamics, problem, margin_symbol)]
         v, a = ca.SX.sym("qd", n), ca.SX.sym("qdd", n)
         friction = ca.Function("friction", [v], [self.dynamics.friction(v)])
         friction_rate = ca.Function("friction_rate", [v, a], [ca.jtimes(self.dynamics.friction(v), v, a)])
@@ -128,7 +129,8 @@ class ChebyshevNLP(NLP):
 
         collision_params = ca.vertcat(*[c.parameters for c in self.constraints])
         super().__init__(
-            x=ca.vertcat(ca.vec(X), ca.vec(Qc), tf), p=ca.vertcat(mu, collision_params, ca.vec(rows), ca.vec(drows)),
+            x=ca.vertcat(ca.vec(X), ca.vec(Qc), tf),
+            p=ca.vertcat(mu, margin_symbol, collision_params, ca.vec(rows), ca.vec(drows)),
             f=objective, g=ca.vertcat(*g), lbg=np.concatenate(lbg), ubg=np.concatenate(ubg), shape_key=shape_key)
         self.s_knots = lobatto_points(N)
         self.n_checks = Qc.size2()
@@ -146,16 +148,16 @@ class ChebyshevNLP(NLP):
         ubx = np.concatenate([upper.ravel(order="F"), checks, [problem.time.max]])
         return lbx, ubx
 
-    def parameters(self, problem: Problem, check_fractions: np.ndarray | None = None) -> np.ndarray:
-        """p for this problem; `check_fractions` (≤ adaptive_checks values in [0, 1], fraction of t_f)
-        moves the adaptive check slots, the others stay at their defaults."""
+    def parameters(self, problem: Problem, refinement: Refinement = Refinement()) -> np.ndarray:
+        """p for this problem; the refinement's first check fractions move the adaptive slots (the rest stay
+        at their defaults) and its extra margin adds to the clearance margin (capped at MAX_MARGIN)."""
         s = self.adaptive_default.copy()
-        if check_fractions is not None and len(check_fractions):
-            chosen = 2.0 * np.clip(np.asarray(check_fractions, dtype=float), 0, 1) - 1.0
-            s[: len(chosen)] = chosen[: len(s)]
+        chosen = 2.0 * np.clip(refinement.check_fractions[: len(s)], 0, 1) - 1.0
+        s[: len(chosen)] = chosen
+        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN)
         collision = [c.parameter_values(problem) for c in self.constraints]
         rows, drows = interpolation_matrix(self.N, s), derivative_matrix(self.N, s)
-        return np.concatenate([[problem.mu], *collision, rows.ravel(order="F"), drows.ravel(order="F")])
+        return np.concatenate([[problem.mu, margin], *collision, rows.ravel(order="F"), drows.ravel(order="F")])
 
     def initial_guess(self, problem: Problem) -> np.ndarray:
         """Straight joint-space line from start to goal at constant speed over t_f = time.guess (infeasible
@@ -219,7 +221,7 @@ class Chebyshev(Transcription):
         self.knots, self.margin, self.adaptive_checks = knots, margin, adaptive_checks
 
     def shape_key(self, problem: Problem, dynamics_name: str) -> tuple:
-        masks = active_terms(problem, self.margin)
+        masks = active_terms(problem)
         return (self.name, self.knots, self.margin, self.adaptive_checks, dynamics_name, id(problem.robot),
                 problem.scene.n_obstacles, *(mask.tobytes() for mask in masks))
 
