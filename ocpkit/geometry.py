@@ -39,6 +39,10 @@ class Clearances:
     obstacles: np.ndarray
     workspace: np.ndarray
 
+    def smallest(self) -> float:
+        """The smallest clearance of any kind (m); inf when there is nothing to check."""
+        return min([np.inf] + [float(v.min()) for v in (self.self_pairs, self.obstacles, self.workspace) if v.size])
+
 
 def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:
     """Clearances of sphere centres (K, M, 3) against each other, the obstacles and the workspace box."""

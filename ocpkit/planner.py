@@ -3,7 +3,8 @@
 The simultaneous planner (transcription + dynamics + solver) builds one NLP per problem shape and caches
 it with its prepared solver, so a second query of the same shape pays no set-up. After each solve the
 trajectory is verified densely; where a path constraint is violated between check times, the adaptive
-check slots are moved there, the clearance margin grows by twice the deepest contact found, and the NLP is
+check slots are moved there, the clearance margin grows by twice the deepest contact found, the velocity,
+torque and torque-rate limits the NLP uses shrink by the excess found (plus 0.5 %), and the NLP is
 re-solved warm-started (no rebuild), for at most `refinements` rounds. A check at the worst time alone
 rarely suffices: with the constraint active, the polynomial then dips just beside the new check.
 """
@@ -12,7 +13,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -24,6 +25,8 @@ from ocpkit.transcription.base import NLP, TRANSCRIPTIONS, Refinement
 from ocpkit.verify import Verification, verify
 
 PLANNERS: Registry[Any] = Registry("planner", "ocpkit.planners")
+GUESSES: Registry[Callable[[Problem, NLP], np.ndarray]] = Registry("initial guess", "ocpkit.guesses")
+GUESSES.register("line", lambda problem, nlp: nlp.initial_guess(problem))
 
 
 @dataclass(frozen=True)
@@ -81,29 +84,32 @@ def plan(problem: Problem, planner: str = "simultaneous", **options: Any) -> Pla
 
 
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str = "casadi-rnea",
-                      solver: str = "ipopt", guess: np.ndarray | None = None, refinements: int = 3,
+                      solver: str = "ipopt", guess: str | np.ndarray = "line", refinements: int = 3,
                       transcription_options: dict | None = None, solver_options: dict | None = None) -> Plan:
     """Path and timing together as one optimal control problem (the paper's method).
 
-    `knots` is N (N + 1 knot points for Chebyshev); `guess` a decision vector for this shape (default:
-    the transcription's straight-line rule); `refinements` bounds the re-solve rounds."""
+    `knots` is N (N + 1 knot points for Chebyshev); `guess` names a registered initial-guess rule ("line":
+    the transcription's straight joint-space line, as in the paper; "ompl": the OMPL + TOPP-RA baseline's
+    motion) or is a decision vector for this shape; `refinements` bounds the re-solve rounds. The guess is
+    part of the computation time."""
     start = time.perf_counter()
     nlp, nlp_solver, setup = prepared(problem, transcription, dynamics, solver,
                                       {"knots": knots, **(transcription_options or {})}, solver_options or {})
-    bounds = nlp.bounds(problem)
-    w = nlp.initial_guess(problem) if guess is None else guess
+    w = GUESSES.get(guess)(problem, nlp) if isinstance(guess, str) else np.asarray(guess, dtype=float)
     refinement = Refinement()
     iterations, rounds = 0, 0
     while True:
-        result = nlp_solver.solve(nlp, w, nlp.parameters(problem, refinement), bounds)
+        result = nlp_solver.solve(nlp, w, nlp.parameters(problem, refinement), nlp.bounds(problem, refinement))
         iterations += result.iterations
         trajectory = nlp.decode(result.w)
         verification = verify(problem, trajectory)
         fresh = verification.violation_times / trajectory.tf
         if verification.ok or result.status != SolverStatus.CONVERGED or rounds >= refinements or not len(fresh):
             break
+        excess = verification.limit_excess
         refinement = Refinement(np.concatenate([fresh, refinement.check_fractions]),  # newest take the slots
-                                refinement.extra_margin + 2.0 * verification.penetration)
+                                refinement.extra_margin + 2.0 * verification.penetration,
+                                refinement.limit_scale * (1.0 - excess - 0.005) if excess > 0 else refinement.limit_scale)
         w, rounds = result.w, rounds + 1
     if result.status != SolverStatus.CONVERGED:
         status = result.status.value

@@ -29,6 +29,7 @@ DYNAMICS_TOLERANCE = 0.01
 GEOMETRY_TOLERANCE = 0.0
 BOUNDARY_TOLERANCE = 1e-6
 GEOMETRY_CHECKS = ("self_collision", "obstacle", "workspace")
+SCALED_LIMITS = ("velocity", "torque", "torque_rate")
 
 
 @dataclass(frozen=True)
@@ -56,6 +57,11 @@ class Verification:
     @property
     def ok(self) -> bool:
         return all(c.ok for c in self.checks)
+
+    @property
+    def limit_excess(self) -> float:
+        """Largest relative excess over a velocity, torque or torque-rate limit beyond its tolerance, or 0."""
+        return max([0.0] + [c.worst - c.tolerance for c in self.checks if c.name in SCALED_LIMITS])
 
     @property
     def penetration(self) -> float:

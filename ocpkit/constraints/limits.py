@@ -11,14 +11,15 @@ from ocpkit.robots import Robot
 
 
 class _RobotLimit:
-    """Shared parts of the limit constraints: they read only the robot, never parameters."""
+    """Shared parts of the limit constraints: the robot's limits, velocity, torque and torque rate scaled by
+    `scale` (a CasADi expression ≤ 1 that a refinement round may lower; no parameters of their own)."""
 
     name = ""
     enforced_by_knot_bounds = False
     parameters = ca.SX(0, 1)
 
-    def __init__(self, robot: Robot) -> None:
-        self.robot = robot
+    def __init__(self, robot: Robot, scale: ca.SX) -> None:
+        self.robot, self.scale = robot, scale
 
     def parameter_values(self, problem: Problem) -> np.ndarray:
         return np.zeros(0)
@@ -33,7 +34,7 @@ class StateLimits(_RobotLimit):
     def evaluate(self, point: PointValues) -> tuple[ca.SX, np.ndarray, np.ndarray]:
         r = self.robot
         ones = np.ones(r.n)
-        return (ca.vertcat(point.q, point.qd / ca.DM(r.qd_max)), np.concatenate([r.q_lower, -ones]),
+        return (ca.vertcat(point.q, point.qd / ca.DM(r.qd_max) / self.scale), np.concatenate([r.q_lower, -ones]),
                 np.concatenate([r.q_upper, ones]))
 
 
@@ -43,7 +44,7 @@ class TorqueLimit(_RobotLimit):
     name = "torque"
 
     def evaluate(self, point: PointValues) -> tuple[ca.SX, np.ndarray, np.ndarray]:
-        return point.tau / ca.DM(self.robot.tau_max), -np.ones(self.robot.n), np.ones(self.robot.n)
+        return point.tau / ca.DM(self.robot.tau_max) / self.scale, -np.ones(self.robot.n), np.ones(self.robot.n)
 
 
 class TorqueRateLimit(_RobotLimit):
@@ -52,7 +53,7 @@ class TorqueRateLimit(_RobotLimit):
     name = "torque_rate"
 
     def evaluate(self, point: PointValues) -> tuple[ca.SX, np.ndarray, np.ndarray]:
-        rate = point.dtau_ds / ca.DM(self.robot.taud_max)
+        rate, limit = point.dtau_ds / ca.DM(self.robot.taud_max), point.dt_ds * self.scale
         n = self.robot.n
-        return (ca.vertcat(rate - point.dt_ds, rate + point.dt_ds),
+        return (ca.vertcat(rate - limit, rate + limit),
                 np.concatenate([np.full(n, -np.inf), np.zeros(n)]), np.concatenate([np.zeros(n), np.full(n, np.inf)]))

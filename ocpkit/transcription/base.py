@@ -24,10 +24,12 @@ from ocpkit.trajectory import Trajectory
 @dataclass(frozen=True)
 class Refinement:
     """What a refinement round may change without a rebuild: where the adaptive check slots sit (fractions
-    of t_f, newest first) and how much the clearance margin grows (m)."""
+    of t_f, newest first), how much the clearance margin grows (m), and the fraction of the velocity, torque
+    and torque-rate limits the NLP may use."""
 
     check_fractions: np.ndarray = field(default_factory=lambda: np.zeros(0))
     extra_margin: float = 0.0
+    limit_scale: float = 1.0
 
 
 @dataclass
@@ -44,7 +46,7 @@ class NLP(ABC):
     shape_key: tuple
 
     @abstractmethod
-    def bounds(self, problem: Problem) -> tuple[np.ndarray, np.ndarray]:
+    def bounds(self, problem: Problem, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
         """(lbx, ubx) for this problem: limits, boundary conditions, time bounds."""
 
     @abstractmethod

@@ -32,8 +32,9 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.constraints import PointValues, SphereCollision, StateLimits, TorqueLimit, TorqueRateLimit
-from ocpkit.constraints.collision import MAX_MARGIN, active_terms
+from ocpkit.constraints.collision import MAX_MARGIN, reachable_faces
 from ocpkit.dynamics.base import make_dynamics
+from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot
 from ocpkit.trajectory import Samples, Trajectory
@@ -79,13 +80,13 @@ class ChebyshevNLP(NLP):
         tf = ca.SX.sym("tf")
         Q, Qd, Qdd, U = (X[k * n:(k + 1) * n, :] for k in range(4))
         tau_max = ca.DM(robot.tau_max)
-        mu, margin_symbol = ca.SX.sym("mu"), ca.SX.sym("margin")
+        mu, margin_symbol, limit_scale = ca.SX.sym("mu"), ca.SX.sym("margin"), ca.SX.sym("limit_scale")
         self.margin = margin
         rows = ca.SX.sym("adaptive_rows", adaptive_checks, N + 1)  # L(s_k), one row per slot
         drows = ca.SX.sym("adaptive_drows", adaptive_checks, N + 1)  # d/ds L(s_k)
 
-        self.constraints = [StateLimits(robot), TorqueLimit(robot), TorqueRateLimit(robot),
-                            SphereCollision(self.dynamics, problem, margin_symbol)]
+        self.constraints = [StateLimits(robot, limit_scale), TorqueLimit(robot, limit_scale),
+                            TorqueRateLimit(robot, limit_scale), SphereCollision(self.dynamics, problem, margin_symbol)]
         v, a = ca.SX.sym("qd", n), ca.SX.sym("qdd", n)
         friction = ca.Function("friction", [v], [self.dynamics.friction(v)])
         friction_rate = ca.Function("friction_rate", [v, a], [ca.jtimes(self.dynamics.friction(v), v, a)])
@@ -130,17 +131,17 @@ class ChebyshevNLP(NLP):
         collision_params = ca.vertcat(*[c.parameters for c in self.constraints])
         super().__init__(
             x=ca.vertcat(ca.vec(X), ca.vec(Qc), tf),
-            p=ca.vertcat(mu, margin_symbol, collision_params, ca.vec(rows), ca.vec(drows)),
+            p=ca.vertcat(mu, margin_symbol, limit_scale, collision_params, ca.vec(rows), ca.vec(drows)),
             f=objective, g=ca.vertcat(*g), lbg=np.concatenate(lbg), ubg=np.concatenate(ubg), shape_key=shape_key)
         self.s_knots = lobatto_points(N)
         self.n_checks = Qc.size2()
 
     # -- numbers for one problem -------------------------------------------------------------------
-    def bounds(self, problem: Problem) -> tuple[np.ndarray, np.ndarray]:
+    def bounds(self, problem: Problem, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
         r, n, N = self.robot, self.n, self.N
-        free = np.full(n, np.inf)
-        lower = np.tile(np.concatenate([r.q_lower, -r.qd_max, -free, -free])[:, None], (1, N + 1))
-        upper = np.tile(np.concatenate([r.q_upper, r.qd_max, free, free])[:, None], (1, N + 1))
+        free, qd_max = np.full(n, np.inf), r.qd_max * refinement.limit_scale
+        lower = np.tile(np.concatenate([r.q_lower, -qd_max, -free, -free])[:, None], (1, N + 1))
+        upper = np.tile(np.concatenate([r.q_upper, qd_max, free, free])[:, None], (1, N + 1))
         for i, q in ((0, problem.goal), (N, problem.start)):  # rest at both ends, eq. (10)
             lower[: 3 * n, i] = upper[: 3 * n, i] = np.concatenate([q, np.zeros(2 * n)])
         checks = np.full(n * self.n_checks, np.inf)
@@ -150,14 +151,18 @@ class ChebyshevNLP(NLP):
 
     def parameters(self, problem: Problem, refinement: Refinement = Refinement()) -> np.ndarray:
         """p for this problem; the refinement's first check fractions move the adaptive slots (the rest stay
-        at their defaults) and its extra margin adds to the clearance margin (capped at MAX_MARGIN)."""
+        at their defaults) and its extra margin adds to the clearance margin. The margin is capped at
+        MAX_MARGIN and at half the start's and goal's clearance: both are fixed, so a larger margin would
+        make the NLP infeasible."""
         s = self.adaptive_default.copy()
         chosen = 2.0 * np.clip(refinement.check_fractions[: len(s)], 0, 1) - 1.0
         s[: len(chosen)] = chosen
-        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN)
+        ends = clearances(self.robot, problem.scene, sphere_centers(self.robot, np.stack([problem.start, problem.goal])))
+        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN, 0.5 * ends.smallest())
         collision = [c.parameter_values(problem) for c in self.constraints]
         rows, drows = interpolation_matrix(self.N, s), derivative_matrix(self.N, s)
-        return np.concatenate([[problem.mu, margin], *collision, rows.ravel(order="F"), drows.ravel(order="F")])
+        return np.concatenate([[problem.mu, margin, refinement.limit_scale], *collision, rows.ravel(order="F"),
+                               drows.ravel(order="F")])
 
     def initial_guess(self, problem: Problem) -> np.ndarray:
         """Straight joint-space line from start to goal at constant speed over t_f = time.guess (infeasible
@@ -221,9 +226,8 @@ class Chebyshev(Transcription):
         self.knots, self.margin, self.adaptive_checks = knots, margin, adaptive_checks
 
     def shape_key(self, problem: Problem, dynamics_name: str) -> tuple:
-        masks = active_terms(problem)
         return (self.name, self.knots, self.margin, self.adaptive_checks, dynamics_name, id(problem.robot),
-                problem.scene.n_obstacles, *(mask.tobytes() for mask in masks))
+                problem.scene.n_obstacles, reachable_faces(problem).tobytes())
 
     def build(self, problem: Problem, dynamics_name: str) -> ChebyshevNLP:
         return ChebyshevNLP(problem, dynamics_name, self.knots, self.margin, self.adaptive_checks,

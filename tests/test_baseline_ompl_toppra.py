@@ -1,0 +1,133 @@
+"""The OMPL + TOPP-RA baseline: OMPL sees exactly the verifier's collision model, seeded runs repeat, bad
+start/goal fail fast with the contact named, and a paper case is planned from rest to rest."""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+import pytest
+from helpers import REPO
+
+import ocpkit
+import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
+from ocpkit.baselines.ompl_toppra import FreeSpace, _space_information, _state, ompl_guess, plan_ompl_toppra
+from ocpkit.errors import RegistryError, ScenarioError
+from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.transcription.base import TRANSCRIPTIONS
+from ocpkit.verify import GEOMETRY_TOLERANCE
+
+
+@pytest.fixture(scope="module")
+def case1():
+    return ocpkit.load_scenario(REPO / "scenarios/paper/case1.yaml")
+
+
+@pytest.fixture(scope="module")
+def configurations(case1):
+    """300 seeded uniform configurations inside the joint limits, (300, n)."""
+    robot = case1.robot
+    return np.random.default_rng(7).uniform(robot.q_lower, robot.q_upper, (300, robot.n))
+
+
+def verifier_says_free(problem, q):
+    """The verifier's geometric verdict per configuration: no penetration beyond its tolerance, shape (K,)."""
+    c = clearances(problem.robot, problem.scene, sphere_centers(problem.robot, q))
+    penetration = np.concatenate([-c.self_pairs, -c.obstacles.reshape(len(q), -1), -c.workspace.reshape(len(q), -1)],
+                                 axis=1)
+    return penetration.max(axis=1) <= GEOMETRY_TOLERANCE
+
+
+def test_ompl_validity_checker_agrees_with_the_verifier(case1, configurations):
+    si = _space_information(case1, FreeSpace(case1, 0.0), resolution=0.01)
+    ompl_free = np.array([si.isValid(_state(si, q)) for q in configurations])
+    expected = verifier_says_free(case1, configurations)
+    assert 50 < expected.sum() < len(configurations) - 50  # both verdicts are well represented
+    np.testing.assert_array_equal(ompl_free, expected)
+
+
+def test_the_margin_rejects_configurations_closer_than_it(case1, configurations):
+    touching = FreeSpace(case1, 0.0).clearance(configurations)
+    kept = FreeSpace(case1, 0.05).free(configurations)
+    np.testing.assert_array_equal(kept, touching >= 0.05)
+    assert np.any((touching >= 0) & ~kept)
+
+
+def test_a_segment_through_an_obstacle_is_rejected_although_its_ends_are_free(case1):
+    free = FreeSpace(case1, 0.0)
+    a, b = case1.start, case1.goal
+    middle = a + np.outer(np.linspace(0, 1, 201), b - a)
+    assert free.free(np.stack([a, b])).all() and not free.free(middle).all()  # case1's straight line hits
+    assert not free.segment_free(a, b, resolution=0.01)
+    assert free.segment_free(a, b, resolution=10.0)  # one check, at b: the resolution is what finds it
+
+
+def test_an_unknown_ompl_planner_is_named_with_the_known_ones(case1):
+    with pytest.raises(RegistryError, match="'rrt-magic'.*rrtconnect"):
+        ocpkit.plan(case1, planner="ompl-toppra", planner_name="rrt-magic")
+
+
+def test_a_goal_in_collision_fails_fast_naming_the_contact(case1, configurations):
+    goal = configurations[~verifier_says_free(case1, configurations)][0]
+    began = time.perf_counter()
+    with pytest.raises(ScenarioError, match=r"goal configuration is in collision: .*sphere \d+ \(link_"):
+        plan_ompl_toppra(dataclasses.replace(case1, goal=goal), planning_time=30.0)
+    assert time.perf_counter() - began < 2.0  # no planner ran into its budget
+
+
+def test_a_start_outside_the_limits_names_the_joint(case1):
+    start = case1.start.copy()
+    start[2] = case1.robot.q_upper[2] + 0.1
+    with pytest.raises(ScenarioError, match=r"start: joint 3 \(joint_3\)"):
+        plan_ompl_toppra(dataclasses.replace(case1, start=start))
+
+
+def test_no_path_within_the_budget_is_a_status_and_the_robot_holds_still(case1):
+    plan = plan_ompl_toppra(case1, planning_time=0.0)
+    assert plan.status == "no_path" and not plan.ok
+    samples = plan.trajectory.sample()
+    np.testing.assert_array_equal(samples.q, np.tile(case1.start, (len(samples.t), 1)))
+    assert not {c.name: c for c in plan.verification.checks}["boundary"].ok  # the goal is not reached
+
+
+@pytest.mark.slow
+def test_seeded_runs_repeat_exactly(case1):
+    first, second = (plan_ompl_toppra(case1, seed=3) for _ in range(2))
+    assert first.trajectory.tf == second.trajectory.tf
+    np.testing.assert_array_equal(first.trajectory.knots.q, second.trajectory.knots.q)
+    other = plan_ompl_toppra(case1, seed=4)
+    assert other.trajectory.tf != first.trajectory.tf  # the seed is what fixes the path
+
+
+@pytest.mark.slow
+def test_case1_is_planned_from_rest_to_rest_and_only_the_torque_rate_fails(case1):
+    plan = ocpkit.plan(case1, planner="ompl-toppra", knots=12, solver="ipopt")  # options of other planners ignored
+    samples = plan.trajectory.sample()
+    np.testing.assert_allclose(samples.q[[0, -1]], [case1.start, case1.goal], atol=1e-9)
+    np.testing.assert_allclose(samples.qd[[0, -1]], 0.0, atol=1e-9)
+    np.testing.assert_allclose(samples.qdd[[0, -1]], 0.0, atol=1e-9)
+    failed = {c.name for c in plan.verification.checks if not c.ok}
+    assert failed <= {"torque_rate"}  # TOPP-RA cannot bound it; everything else holds
+    assert plan.status == ("verified" if not failed else "violated")
+    assert case1.velocity_lower_bound() < plan.trajectory.tf < 2.0
+    assert plan.method == {"planner": "ompl-toppra", "transcription": "toppra", "knots": 1000,
+                           "dynamics": "pinocchio", "solver": "rrtconnect"}
+    extra = plan.stats.extra
+    assert extra["validity_checks"] > 0 and extra["waypoints"] >= 2
+    assert all(extra[key] > 0 for key in ("path_time_s", "simplify_time_s", "toppra_time_s"))
+
+
+@pytest.mark.slow
+def test_ompl_guess_is_the_baseline_motion_on_the_nlp_grid(case1):
+    nlp = TRANSCRIPTIONS.get("chebyshev")(knots=6).build(case1, "casadi-rnea")
+    baseline = plan_ompl_toppra(case1)
+    w = ompl_guess(case1, nlp)
+    assert w.shape == nlp.initial_guess(case1).shape
+    decoded = nlp.decode(w)
+    assert decoded.tf == pytest.approx(baseline.trajectory.tf)
+    np.testing.assert_allclose(decoded.knots.q[[0, -1]], [case1.start, case1.goal], atol=1e-9)
+    middle = decoded.tf / 2
+    np.testing.assert_allclose(decoded.interpolant(np.array([middle])).q,
+                               baseline.trajectory.interpolant(np.array([middle])).q, atol=0.05)
+    np.testing.assert_array_equal(ompl_guess(case1, nlp, planning_time=0.0), nlp.initial_guess(case1))
