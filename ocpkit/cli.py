@@ -35,7 +35,8 @@ def _plan_command(args: argparse.Namespace) -> int:
 def _bench_command(args: argparse.Namespace) -> int:
     from ocpkit.bench.paper import run_paper_benchmark
 
-    run_paper_benchmark(Path(args.scenarios), Path(args.out), repeats=args.repeats)
+    run_paper_benchmark(Path(args.scenarios), Path(args.out), repeats=args.repeats,
+                        hard=Path(args.hard) if args.hard else None)
     return 0
 
 
@@ -56,6 +57,8 @@ def parser() -> argparse.ArgumentParser:
     b = commands.add_parser("bench", help="run a benchmark suite")
     b.add_argument("suite", choices=["paper"])
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml")
+    b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
+                   "('' to skip it)")
     b.add_argument("--out", default="results/paper", help="output folder (results.csv, trajectories/)")
     b.add_argument("--repeats", type=int, default=5, help="solves per plan; the median is reported")
     b.set_defaults(run=_bench_command)

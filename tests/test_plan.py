@@ -90,12 +90,14 @@ def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
     run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1, dynamics=("casadi-rnea", "casadi"))
     rows = list(csv.DictReader((tmp_path / "out/results.csv").open()))
     assert tuple(rows[0]) == RESULT_COLUMNS
-    assert [(r["dynamics"], r["knots"], r["status"]) for r in rows] == [
-        ("casadi-rnea", "12", "verified"), ("casadi-rnea", "8", "verified"),
-        ("casadi", "12", "verified"), ("casadi", "8", "verified")]
+    assert [(r["planner"], r["dynamics"], r["knots"], r["status"]) for r in rows[:4]] == [
+        ("simultaneous", "casadi-rnea", "12", "verified"), ("simultaneous", "casadi-rnea", "8", "verified"),
+        ("simultaneous", "casadi", "12", "verified"), ("simultaneous", "casadi", "8", "verified")]
+    assert rows[4]["planner"] == "ompl-toppra" and rows[4]["status"] in ("verified", "violated")
+    assert (tmp_path / "out/trajectories/case4-ompl-toppra-toppra-1000.json").exists()
     assert (tmp_path / "out/trajectories/case4-simultaneous-chebyshev-12.json").exists()
     printed = capsys.readouterr().out
-    assert "motion time t_f" in printed and "paper set-up" in printed and "machine:" in printed
+    assert "motion time t_f" in printed and "paper set-up" in printed and "ratio sim / baseline" in printed
 
 
 def test_refinement_repairs_contact_between_check_times():

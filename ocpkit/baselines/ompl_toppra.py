@@ -54,7 +54,7 @@ import pinocchio as pin
 
 from ocpkit.errors import RegistryError
 from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.planner import PLANNERS, Plan, PlanStats
+from ocpkit.planner import GUESSES, PLANNERS, Plan, PlanStats
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot
 from ocpkit.scenario import validate
@@ -378,3 +378,4 @@ def ompl_guess(problem: Problem, nlp: NLP, **baseline_options: Any) -> np.ndarra
 
 
 PLANNERS.register("ompl-toppra", plan_ompl_toppra)
+GUESSES.register("ompl", ompl_guess)

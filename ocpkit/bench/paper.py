@@ -1,8 +1,9 @@
-"""The paper's experiment (Table II): four pick-and-place cases at 12 and 8 knots, μ = 0.3.
+"""The paper's experiment (Table II): four pick-and-place cases at 12 and 8 knots, μ = 0.3, against the
+path–velocity decomposition baseline (OMPL + TOPP-RA), plus hybrid seeding of the simultaneous planner.
 
 Computation time is the wall time of one plan whose NLP shape is already built (all refinement rounds
 and the dense verification included), median over `repeats` runs; set-up is the first build of a shape.
-Every dynamics form given is run in the same process, so their times compare on the same machine state.
+Every method runs in the same process, so their times compare on the same machine state.
 """
 
 from __future__ import annotations
@@ -30,42 +31,65 @@ WIDTH = 24
 
 @dataclass(frozen=True)
 class Measured:
-    """One case at one knot count: the last plan, median computation time and set-up time (s)."""
+    """One method on one case: the last plan, median computation time and set-up time (s)."""
 
     plan: Plan
     solve_time: float
     setup_time: float
 
 
+def measure(problem: Problem, repeats: int, **options) -> Measured:
+    """Plan `problem` `repeats` times with `options` (as for `ocpkit.plan`)."""
+    plans = [plan(problem, **options) for _ in range(max(repeats, 1))]
+    return Measured(plans[-1], statistics.median(p.stats.solve_time for p in plans), plans[0].stats.setup_time)
+
+
 def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
-                        dynamics: tuple[str, ...] = ("casadi-rnea", "casadi")) -> list[dict]:
-    """Solve every case at every knot count with every dynamics form; print the table (the first form in the
-    paper's layout, the others summarized), write results.csv and trajectories/."""
-    files = sorted(Path(scenarios).glob("case*.yaml"))
-    if not files:
-        raise ScenarioError(f"no case*.yaml in {scenarios}")
-    problems = [load_scenario(f) for f in files]
-    rows, measured = [], {}
+                        dynamics: tuple[str, ...] = ("casadi-rnea", "casadi"), hard: Path | None = None) -> list[dict]:
+    """Solve every case at every knot count with every dynamics form and with the baseline; print the
+    tables; write results.csv and trajectories/. With `hard` (a folder of scenarios), also compare the
+    straight-line and the OMPL initial guess on the paper cases and those."""
+    problems = _load_all(Path(scenarios))
+    rows, simultaneous, baseline = [], {}, {}
     for form in dynamics:
         for knots in KNOTS:
             for problem in problems:
-                m = _measure(problem, knots, form, repeats)
-                measured[form, problem.name, knots] = m
+                m = measure(problem, repeats, knots=knots, dynamics=form)
+                simultaneous[form, problem.name, knots] = m
                 rows.append(result_row("paper", problem.name, m.plan, m.solve_time, m.setup_time))
                 if form == dynamics[0]:
-                    name = f"{problem.name}-{m.plan.method['planner']}-{m.plan.method['transcription']}-{knots}.json"
-                    write_json(out / "trajectories" / name, m.plan.trajectory, trajectory_header(problem, m.plan))
+                    _write_trajectory(out, problem, m.plan)
+    for problem in problems:
+        m = baseline[problem.name] = measure(problem, repeats, planner="ompl-toppra")
+        rows.append(result_row("paper", problem.name, m.plan, m.solve_time, m.setup_time))
+        _write_trajectory(out, problem, m.plan)
+    first = {(c, k): m for (f, c, k), m in simultaneous.items() if f == dynamics[0]}
+    print(_paper_table(problems, first, dynamics[0]))
+    print(_comparison(problems, simultaneous, dynamics))
+    print(_baseline_table(problems, first, baseline))
+    if hard is not None:
+        seeding = {(p.name, guess): measure(p, 1, knots=12, dynamics=dynamics[0], guess=guess)
+                   for p in problems + _load_all(Path(hard)) for guess in ("line", "ompl")}
+        rows += [result_row(f"seeding-{guess}", name, m.plan, m.solve_time, m.setup_time)
+                 for (name, guess), m in seeding.items()]
+        print(_seeding_table(seeding))
     _write_csv(out / "results.csv", rows)
-    print(_paper_table(problems, {(c, k): m for (f, c, k), m in measured.items() if f == dynamics[0]}, dynamics[0]))
-    print(_comparison(problems, measured, dynamics))
     print(f"machine: {_cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
-          f"computation times are medians of {repeats} runs per plan")
+          f"computation times are medians of {repeats} runs per plan (seeding: 1 run)")
     return rows
 
 
-def _measure(problem: Problem, knots: int, dynamics: str, repeats: int) -> Measured:
-    plans = [plan(problem, knots=knots, dynamics=dynamics) for _ in range(max(repeats, 1))]
-    return Measured(plans[-1], statistics.median(p.stats.solve_time for p in plans), plans[0].stats.setup_time)
+def _load_all(folder: Path) -> list[Problem]:
+    files = sorted(folder.glob("*.yaml"))
+    if not files:
+        raise ScenarioError(f"no scenario files (*.yaml) in {folder}")
+    return [load_scenario(f) for f in files]
+
+
+def _write_trajectory(out: Path, problem: Problem, result: Plan) -> None:
+    m = result.method
+    name = f"{problem.name}-{m['planner']}-{m['transcription']}-{m['knots']}.json"
+    write_json(out / "trajectories" / name, result.trajectory, trajectory_header(problem, result))
 
 
 def _write_csv(path: Path, rows: list[dict]) -> None:
@@ -93,7 +117,7 @@ def _paper_table(problems: list[Problem], measured: dict, dynamics: str) -> str:
 
 
 def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ...]) -> str:
-    lines = [f"{'dynamics':<14}{'knots':>6}{'median computation':>20}{'vs paper':>10}{'set-up':>9}"
+    lines = ["", f"{'dynamics':<14}{'knots':>6}{'median computation':>20}{'vs paper':>10}{'set-up':>9}"
              f"{'paper set-up':>14}{'verified':>10}"]
     for form in dynamics:
         for knots in KNOTS:
@@ -104,6 +128,38 @@ def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ..
             verified = sum(m.plan.ok for m in cases)
             lines.append(f"{form:<14}{knots:>6}{median:>19.3f}s{speedup:>9.1f}x{setup:>8.2f}s{PAPER_SETUP:>13.1f}s"
                          f"{verified:>8}/{len(cases)}")
+    return "\n".join(lines)
+
+
+def _baseline_table(problems: list[Problem], simultaneous: dict, baseline: dict) -> str:
+    head = f"{'':<26}" + "".join(f"{p.name:>{WIDTH}}" for p in problems)
+    lines = ["", "Path-velocity decomposition baseline (OMPL RRTConnect + TOPP-RA), same problems, same verify",
+             head, "-" * len(head)]
+    stat = lambda key: [baseline[p.name].plan.stats.extra.get(key, 0.0) for p in problems]  # noqa: E731
+    cells = {
+        "t_f baseline": [f"{baseline[p.name].plan.trajectory.tf:.3f}" for p in problems],
+        "t_f simultaneous (12)": [f"{simultaneous[p.name, 12].plan.trajectory.tf:.3f}" for p in problems],
+        "ratio sim / baseline": [f"{simultaneous[p.name, 12].plan.trajectory.tf / baseline[p.name].plan.trajectory.tf:.3f}"
+                                 for p in problems],
+        "computation [s]": [f"{baseline[p.name].solve_time:.3f}" for p in problems],
+        "  path + simplify [s]": [f"{a + b:.3f}" for a, b in zip(stat("path_time_s"), stat("simplify_time_s"))],
+        "  smoothing [s]": [f"{t:.3f}" for t in stat("smooth_time_s")],
+        "  TOPP-RA [s]": [f"{t:.3f}" for t in stat("toppra_time_s")],
+        "status": [baseline[p.name].plan.status for p in problems],
+    }
+    lines += [f"{label:<26}" + "".join(f"{c:>{WIDTH}}" for c in row) for label, row in cells.items()]
+    for p in problems:
+        lines.append(f"  {p.name} baseline checks: {baseline[p.name].plan.verification.summary()}")
+    return "\n".join(lines)
+
+
+def _seeding_table(seeding: dict) -> str:
+    lines = ["", "Hybrid seeding at 12 knots: the paper's straight-line guess vs the OMPL + TOPP-RA motion as guess "
+             "(the baseline's time included)", f"{'case':<12}{'guess':<7}{'status':>12}{'t_f':>8}{'time [s]':>10}"
+             f"{'iterations':>12}"]
+    for (name, guess), m in seeding.items():
+        lines.append(f"{name:<12}{guess:<7}{m.plan.status:>12}{m.plan.trajectory.tf:>8.3f}{m.solve_time:>10.2f}"
+                     f"{m.plan.stats.iterations:>12}")
     return "\n".join(lines)
 
 

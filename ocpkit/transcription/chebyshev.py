@@ -32,7 +32,7 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.constraints import PointValues, SphereCollision, StateLimits, TorqueLimit, TorqueRateLimit
-from ocpkit.constraints.collision import MAX_MARGIN, reachable_faces
+from ocpkit.constraints.collision import MAX_MARGIN, active_terms
 from ocpkit.dynamics.base import make_dynamics
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.problem import Problem
@@ -227,7 +227,7 @@ class Chebyshev(Transcription):
 
     def shape_key(self, problem: Problem, dynamics_name: str) -> tuple:
         return (self.name, self.knots, self.margin, self.adaptive_checks, dynamics_name, id(problem.robot),
-                problem.scene.n_obstacles, reachable_faces(problem).tobytes())
+                problem.scene.n_obstacles, *(mask.tobytes() for mask in active_terms(problem)))
 
     def build(self, problem: Problem, dynamics_name: str) -> ChebyshevNLP:
         return ChebyshevNLP(problem, dynamics_name, self.knots, self.margin, self.adaptive_checks,
