@@ -68,11 +68,6 @@ class Verification:
         """Deepest sphere contact of any kind (m), 0 if there is none."""
         return max([0.0] + [c.worst for c in self.checks if c.name in GEOMETRY_CHECKS])
 
-    @property
-    def worst(self) -> Check:
-        """The check furthest beyond (or closest to) its tolerance."""
-        return max(self.checks, key=lambda c: c.worst - c.tolerance)
-
     def summary(self) -> str:
         """One line: the failed checks with their times, or every check's worst value if all pass."""
         failed = [c for c in self.checks if not c.ok]
