@@ -26,6 +26,8 @@ def _plan_command(args: argparse.Namespace) -> int:
           f"+ set-up {result.stats.setup_time:.3f} s, {result.stats.iterations} iterations, "
           f"{result.stats.rounds} refinement rounds")
     print(f"checks: {v.summary()}")
+    if any(c.name == "dynamics" and not c.ok for c in v.checks):
+        print("hint: the polynomial does not resolve the dynamics between knots; try more knots (--knots)")
     if args.output:
         write_json(args.output, result.trajectory, trajectory_header(problem, result))
         print(f"wrote {args.output}")
