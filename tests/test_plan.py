@@ -108,3 +108,16 @@ def test_refinement_repairs_contact_between_check_times():
     refined = ocpkit.plan(problem, knots=8, transcription_options=no_margin)
     assert refined.ok and refined.stats.rounds >= 1
     assert refined.stats.setup_time == 0.0  # the same NLP, re-solved: refinement needs no rebuild
+
+
+def test_ompl_guess_seeds_the_simultaneous_planner():
+    problem = ocpkit.load_scenario(CASES[3])
+    seeded = ocpkit.plan(problem, knots=8, guess="ompl")
+    assert seeded.ok, seeded.verification.summary()
+    assert seeded.trajectory.tf == pytest.approx(ocpkit.plan(problem, knots=8).trajectory.tf, rel=0.02)
+
+
+def test_cli_runs_the_baseline_and_reports_what_it_violates(capsys):
+    code = main(["plan", str(CASES[2]), "--planner", "ompl-toppra"])
+    printed = capsys.readouterr().out
+    assert code == 1 and "status violated" in printed and "torque_rate" in printed
