@@ -3,7 +3,8 @@
 The simultaneous planner (transcription + dynamics + solver) builds one NLP per problem shape and caches
 it with its prepared solver, so a second query of the same shape pays no set-up. After each solve the
 trajectory is verified densely; where a path constraint is violated between check times, the adaptive
-check slots are moved there, the clearance margin grows by twice the deepest contact found, the velocity,
+check slots are moved there, the clearance margin grows by twice the deepest contact found (at least 5 mm),
+the velocity,
 torque and torque-rate limits the NLP uses shrink by the excess found (plus 0.5 %), and the NLP is
 re-solved warm-started (no rebuild), for at most `refinements` rounds. A check at the worst time alone
 rarely suffices: with the constraint active, the polynomial then dips just beside the new check.
@@ -84,7 +85,7 @@ def plan(problem: Problem, planner: str = "simultaneous", **options: Any) -> Pla
 
 
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str = "casadi-rnea",
-                      solver: str = "ipopt", guess: str | np.ndarray = "line", refinements: int = 3,
+                      solver: str = "ipopt", guess: str | np.ndarray = "line", refinements: int = 5,
                       transcription_options: dict | None = None, solver_options: dict | None = None) -> Plan:
     """Path and timing together as one optimal control problem (the paper's method).
 
@@ -108,7 +109,7 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
             break
         excess = verification.limit_excess
         refinement = Refinement(np.concatenate([fresh, refinement.check_fractions]),  # newest take the slots
-                                refinement.extra_margin + 2.0 * verification.penetration,
+                                refinement.extra_margin + _margin_step(verification.penetration),
                                 refinement.limit_scale * (1.0 - excess - 0.005) if excess > 0 else refinement.limit_scale)
         w, rounds = result.w, rounds + 1
     if result.status != SolverStatus.CONVERGED:
@@ -119,6 +120,11 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
               "solver": solver}
     stats = PlanStats(time.perf_counter() - start - setup, setup, iterations, rounds, result.message)
     return Plan(trajectory, status, verification, stats, method)
+
+
+def _margin_step(penetration: float) -> float:
+    """Extra clearance margin (m) after a round that found spheres `penetration` m deep in contact."""
+    return max(2.0 * penetration, 0.005) if penetration > 0 else 0.0
 
 
 PLANNERS.register("simultaneous", plan_simultaneous)
