@@ -15,3 +15,7 @@ class ScenarioError(OcpkitError):
 
 class RegistryError(OcpkitError):
     """A component name (transcription, dynamics, solver, planner) is not registered."""
+
+
+class OptionError(OcpkitError):
+    """A planner, transcription or solver option is out of range."""

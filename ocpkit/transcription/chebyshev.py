@@ -21,6 +21,9 @@ constraints are also imposed at extra check times s_k (q lifted there as q_k = L
 Jacobian sparse): one fixed check at the θ-midpoint of every long knot interval, plus `adaptive_checks`
 slots whose interpolation rows are NLP parameters, so a refinement round can move them to where dense
 verification found a violation without rebuilding the NLP.
+
+What is not Chebyshev-specific (the path constraints at a point, the parameter vector, the bounds, the
+straight-line guess) is shared by all transcriptions in assembly.py.
 """
 
 from __future__ import annotations
@@ -29,15 +32,12 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
-import pinocchio as pin
 
-from ocpkit.constraints import PointValues, SphereCollision, StateLimits, TorqueLimit, TorqueRateLimit
-from ocpkit.constraints.collision import MAX_MARGIN, active_terms
-from ocpkit.dynamics.base import make_dynamics
-from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.errors import OptionError
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot
 from ocpkit.trajectory import Samples, Trajectory
+from ocpkit.transcription.assembly import Assembly, joint_samples, knot_columns, problem_shape, straight_line
 from ocpkit.transcription.base import NLP, TRANSCRIPTIONS, Refinement, Transcription
 from ocpkit.transcription.polynomials import (
     clenshaw_curtis_weights, derivative_matrix, differentiation_matrix, interpolation_matrix, lobatto_points)
@@ -52,14 +52,11 @@ class ChebyshevInterpolant:
     robot: Robot
 
     def __call__(self, t: np.ndarray) -> Samples:
-        n_intervals, n, r = self.columns.shape[1] - 1, self.robot.n, self.robot
+        n_intervals, n = self.columns.shape[1] - 1, self.robot.n
         s = 2.0 * np.asarray(t, dtype=float) / self.tf - 1.0
         values = interpolation_matrix(n_intervals, s) @ self.columns.T
         du_dt = derivative_matrix(n_intervals, s) @ self.columns[3 * n:].T * (2.0 / self.tf)
-        q, qd, qdd, u = np.split(values, 4, axis=1)
-        tau = r.tau_max * u + r.friction(qd)
-        taud = r.tau_max * du_dt + r.friction_slope(qd) * qdd
-        return Samples(np.asarray(t, dtype=float), q, qd, qdd, tau, taud)
+        return joint_samples(self.robot, t, *np.split(values, 4, axis=1), du_dt)
 
 
 class ChebyshevNLP(NLP):
@@ -70,7 +67,6 @@ class ChebyshevNLP(NLP):
         robot = problem.robot
         n, N = robot.n, knots
         self.n, self.N, self.robot = n, N, robot
-        self.dynamics = make_dynamics(dynamics_name, robot)
         D, weights = differentiation_matrix(N), clenshaw_curtis_weights(N)
         self.check_s = _fixed_check_times(N)
         self.adaptive_default = _default_adaptive_times(N, adaptive_checks)
@@ -79,114 +75,61 @@ class ChebyshevNLP(NLP):
         Qc = ca.SX.sym("q_check", n, len(self.check_s) + adaptive_checks)
         tf = ca.SX.sym("tf")
         Q, Qd, Qdd, U = (X[k * n:(k + 1) * n, :] for k in range(4))
-        tau_max = ca.DM(robot.tau_max)
-        mu, margin_symbol, limit_scale = ca.SX.sym("mu"), ca.SX.sym("margin"), ca.SX.sym("limit_scale")
-        self.margin = margin
         rows = ca.SX.sym("adaptive_rows", adaptive_checks, N + 1)  # L(s_k), one row per slot
         drows = ca.SX.sym("adaptive_drows", adaptive_checks, N + 1)  # d/ds L(s_k)
+        a = self.assembly = Assembly(problem, dynamics_name, margin, dt_ds=tf / 2)  # path constraints, rows, p
 
-        self.constraints = [StateLimits(robot, limit_scale), TorqueLimit(robot, limit_scale),
-                            TorqueRateLimit(robot, limit_scale), SphereCollision(self.dynamics, problem, margin_symbol)]
-        v, a = ca.SX.sym("qd", n), ca.SX.sym("qdd", n)
-        friction = ca.Function("friction", [v], [self.dynamics.friction(v)])
-        friction_rate = ca.Function("friction_rate", [v, a], [ca.jtimes(self.dynamics.friction(v), v, a)])
-
-        def point(q, qd, qdd, u, du_ds) -> PointValues:
-            """Values at one time; du_ds is d u / d s, so dtau/ds = tau_max du_ds + friction'(qd) (t_f/2) qdd."""
-            return PointValues(q, qd, qdd, tau_max * u + friction(qd), tau_max * du_ds + friction_rate(qd, tf / 2 * qdd),
-                               tf / 2)
         Dc = ca.DM(D)
         dQ, dQd, dQdd, dU = (ca.mtimes(M, Dc.T) for M in (Q, Qd, Qdd, U))
-        g, lbg, ubg = [], [], []
-
-        def add(expr, lower, upper):
-            g.append(expr)
-            lbg.append(np.broadcast_to(lower, (expr.numel(),)))
-            ubg.append(np.broadcast_to(upper, (expr.numel(),)))
-
-        def add_path(values: PointValues, at_knot: bool):
-            for constraint in self.constraints:
-                if not (at_knot and constraint.enforced_by_knot_bounds):
-                    add(*constraint.evaluate(values))
-
         for i in range(N + 1):
-            add(dQ[:, i] - tf / 2 * Qd[:, i], 0.0, 0.0)  # D X = (t_f/2) F(X, U)
-            add(dQd[:, i] - tf / 2 * Qdd[:, i], 0.0, 0.0)
-            add(self.dynamics.residual(Q[:, i], Qd[:, i], Qdd[:, i], tau_max * U[:, i]), 0.0, 0.0)
-            add_path(point(Q[:, i], Qd[:, i], Qdd[:, i], U[:, i], dU[:, i]), True)
+            a.defect(dQ[:, i] - tf / 2 * Qd[:, i])  # D X = (t_f/2) F(X, U)
+            a.defect(dQd[:, i] - tf / 2 * Qdd[:, i])
+            a.dynamics_defect(Q[:, i], Qd[:, i], Qdd[:, i], U[:, i])
+            a.add_path(a.point(Q[:, i], Qd[:, i], Qdd[:, i], U[:, i], dU[:, i]), at_knot=True)
 
         check_rows = [ca.DM(interpolation_matrix(N, self.check_s)), rows]
         check_drows = [ca.DM(derivative_matrix(N, self.check_s)), drows]
         L, Ld = ca.vertcat(*check_rows), ca.vertcat(*check_drows)
         for k in range(L.size1()):
             row, drow = ca.transpose(L[k, :]), ca.transpose(Ld[k, :])
-            add(Qc[:, k] - ca.mtimes(Q, row), 0.0, 0.0)
-            add_path(point(Qc[:, k], ca.mtimes(Qd, row), ca.mtimes(Qdd, row), ca.mtimes(U, row),
-                           ca.mtimes(U, drow)), False)
+            a.defect(Qc[:, k] - ca.mtimes(Q, row))
+            a.add_path(a.point(Qc[:, k], ca.mtimes(Qd, row), ca.mtimes(Qdd, row), ca.mtimes(U, row),
+                               ca.mtimes(U, drow)))
 
         jerk_s = ca.vec(dQdd)  # (D Qdd) column by column; jerk = (2/t_f) jerk_s
         quad = ca.DM(np.kron(weights, problem.jerk_weights))
-        objective = tf + mu * (2.0 / tf) * ca.dot(quad, jerk_s**2)
-
-        collision_params = ca.vertcat(*[c.parameters for c in self.constraints])
-        super().__init__(
-            x=ca.vertcat(ca.vec(X), ca.vec(Qc), tf),
-            p=ca.vertcat(mu, margin_symbol, limit_scale, collision_params, ca.vec(rows), ca.vec(drows)),
-            f=objective, g=ca.vertcat(*g), lbg=np.concatenate(lbg), ubg=np.concatenate(ubg), shape_key=shape_key)
+        objective = tf + a.mu * (2.0 / tf) * ca.dot(quad, jerk_s**2)
+        super().__init__(**a.nlp_fields(ca.vertcat(ca.vec(X), ca.vec(Qc), tf), objective,
+                                        ca.vertcat(ca.vec(rows), ca.vec(drows)), shape_key))
         self.s_knots = lobatto_points(N)
         self.n_checks = Qc.size2()
 
     # -- numbers for one problem -------------------------------------------------------------------
     def bounds(self, problem: Problem, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
-        r, n, N = self.robot, self.n, self.N
-        free, qd_max = np.full(n, np.inf), r.qd_max * refinement.limit_scale
-        lower = np.tile(np.concatenate([r.q_lower, -qd_max, -free, -free])[:, None], (1, N + 1))
-        upper = np.tile(np.concatenate([r.q_upper, qd_max, free, free])[:, None], (1, N + 1))
-        for i, q in ((0, problem.goal), (N, problem.start)):  # rest at both ends, eq. (10)
-            lower[: 3 * n, i] = upper[: 3 * n, i] = np.concatenate([q, np.zeros(2 * n)])
-        checks = np.full(n * self.n_checks, np.inf)
-        lbx = np.concatenate([lower.ravel(order="F"), -checks, [problem.time.min]])
-        ubx = np.concatenate([upper.ravel(order="F"), checks, [problem.time.max]])
-        return lbx, ubx
+        """Knot N is t = 0 (the start), knot 0 is t_f (the goal); the check-point q are free."""
+        return self.assembly.bounds(problem, refinement, self.N + 1, start=self.N, goal=0, free=self.n * self.n_checks)
 
     def parameters(self, problem: Problem, refinement: Refinement = Refinement()) -> np.ndarray:
         """p for this problem; the refinement's first check fractions move the adaptive slots (the rest stay
-        at their defaults) and its extra margin adds to the clearance margin. The margin is capped at
-        MAX_MARGIN and at half the start's and goal's clearance: both are fixed, so a larger margin would
-        make the NLP infeasible."""
+        at their defaults); margin and limit scale as in `Assembly.parameter_values`."""
         s = self.adaptive_default.copy()
         chosen = 2.0 * np.clip(refinement.check_fractions[: len(s)], 0, 1) - 1.0
         s[: len(chosen)] = chosen
-        ends = clearances(self.robot, problem.scene, sphere_centers(self.robot, np.stack([problem.start, problem.goal])))
-        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN, 0.5 * ends.smallest())
-        collision = [c.parameter_values(problem) for c in self.constraints]
         rows, drows = interpolation_matrix(self.N, s), derivative_matrix(self.N, s)
-        return np.concatenate([[problem.mu, margin, refinement.limit_scale], *collision, rows.ravel(order="F"),
-                               drows.ravel(order="F")])
+        return self.assembly.parameter_values(problem, refinement,
+                                              np.concatenate([rows.ravel(order="F"), drows.ravel(order="F")]))
 
     def initial_guess(self, problem: Problem) -> np.ndarray:
-        """Straight joint-space line from start to goal at constant speed over t_f = time.guess (infeasible
-        at the ends, as in the paper), with the rigid-body torque that holds it: rnea(q, qd, 0)."""
-        tf, delta = problem.time.guess, problem.goal - problem.start
-
-        def line(t: np.ndarray) -> Samples:
-            zeros = np.zeros((len(t), self.n))
-            return Samples(t, problem.start + np.outer(t / tf, delta), np.tile(delta / tf, (len(t), 1)), zeros,
-                           zeros, zeros)
-
-        return self.encode(Trajectory(line(np.array([0.0, tf])), line))
+        """The straight joint-space line over t_f = time.guess, as in the paper (`assembly.straight_line`)."""
+        return self.encode(straight_line(problem))
 
     def encode(self, trajectory: Trajectory) -> np.ndarray:
         """Sample `trajectory` at this NLP's knots and check times (scaled to its t_f); u is the rigid-body
         torque rnea(q, qd, qdd) / tau_max of the sampled motion."""
-        tf, r = trajectory.tf, self.robot
+        tf = trajectory.tf
         at = lambda s: trajectory.interpolant(tf * (s + 1.0) / 2.0)  # noqa: E731
         knots, checks = at(self.s_knots), at(np.concatenate([self.check_s, self.adaptive_default]))
-        data = r.model.createData()
-        rigid = np.array([pin.rnea(r.model, data, q, qd, qdd).copy()
-                          for q, qd, qdd in zip(knots.q, knots.qd, knots.qdd)])
-        columns = np.hstack([knots.q, knots.qd, knots.qdd, rigid / r.tau_max])
-        return np.concatenate([columns.ravel(), checks.q.ravel(), [tf]])
+        return np.concatenate([knot_columns(self.robot, knots).ravel(), checks.q.ravel(), [tf]])
 
     def decode(self, w: np.ndarray) -> Trajectory:
         n, N = self.n, self.N
@@ -222,12 +165,11 @@ class Chebyshev(Transcription):
 
     def __init__(self, knots: int = 12, margin: float = 0.01, adaptive_checks: int = 4) -> None:
         if knots < 2:
-            raise ValueError(f"chebyshev needs knots ≥ 2, got {knots}")
+            raise OptionError(f"chebyshev needs knots ≥ 2, got {knots}")
         self.knots, self.margin, self.adaptive_checks = knots, margin, adaptive_checks
 
     def shape_key(self, problem: Problem, dynamics_name: str) -> tuple:
-        return (self.name, self.knots, self.margin, self.adaptive_checks, dynamics_name, id(problem.robot),
-                problem.scene.n_obstacles, *(mask.tobytes() for mask in active_terms(problem)))
+        return (self.name, self.knots, self.margin, self.adaptive_checks, *problem_shape(problem, dynamics_name))
 
     def build(self, problem: Problem, dynamics_name: str) -> ChebyshevNLP:
         return ChebyshevNLP(problem, dynamics_name, self.knots, self.margin, self.adaptive_checks,
