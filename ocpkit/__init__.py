@@ -9,7 +9,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from ocpkit import baselines, dynamics, solvers, transcription  # noqa: E402,F401  (register built-in components)
 from ocpkit.planner import Plan, plan  # noqa: E402
 from ocpkit.problem import Problem, TimeBounds  # noqa: E402
 from ocpkit.robots import Robot, load_robot  # noqa: E402

@@ -1,4 +1,4 @@
-"""Command line: `ocpkit plan SCENARIO` and `ocpkit bench paper`. User mistakes print one line, exit 2."""
+"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper`, `ocpkit list`. User mistakes print one line, exit 2."""
 
 from __future__ import annotations
 
@@ -42,6 +42,19 @@ def _bench_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def _list_command(args: argparse.Namespace) -> int:
+    from ocpkit.dynamics import DYNAMICS
+    from ocpkit.planner import GUESSES, PLANNERS
+    from ocpkit.solvers import SOLVERS
+    from ocpkit.transcription import TRANSCRIPTIONS
+
+    for registry in (TRANSCRIPTIONS, DYNAMICS, SOLVERS, PLANNERS, GUESSES):
+        print(registry.group.removeprefix("ocpkit."))
+        for name in registry.names():
+            print(f"  {name:<17} {registry.description(name)}".rstrip())
+    return 0
+
+
 def parser() -> argparse.ArgumentParser:
     """The `ocpkit` argument parser."""
     main = argparse.ArgumentParser(prog="ocpkit", description=__doc__)
@@ -64,6 +77,9 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--out", default="results/paper", help="output folder (results.csv, trajectories/)")
     b.add_argument("--repeats", type=int, default=5, help="solves per plan; the median is reported")
     b.set_defaults(run=_bench_command)
+    ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, solvers, "
+                             "planners, guesses) with one line each")
+    ls.set_defaults(run=_list_command)
     return main
 
 

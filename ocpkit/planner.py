@@ -27,7 +27,11 @@ from ocpkit.verify import Verification, verify
 
 PLANNERS: Registry[Any] = Registry("planner", "ocpkit.planners")
 GUESSES: Registry[Callable[[Problem, NLP], np.ndarray]] = Registry("initial guess", "ocpkit.guesses")
-GUESSES.register("line", lambda problem, nlp: nlp.initial_guess(problem))
+
+
+def line_guess(problem: Problem, nlp: NLP) -> np.ndarray:
+    """The transcription's straight joint-space line from start to goal (the paper's initial guess)."""
+    return nlp.initial_guess(problem)
 
 
 @dataclass(frozen=True)
@@ -127,4 +131,3 @@ def _margin_step(penetration: float) -> float:
     return max(2.0 * penetration, 0.005) if penetration > 0 else 0.0
 
 
-PLANNERS.register("simultaneous", plan_simultaneous)

@@ -1,41 +1,91 @@
-"""Name → component registries, extendable by third-party packages through Python entry points."""
+"""Name → component registries, filled from Python entry points (one group per family).
+
+Design: pyproject.toml's `[project.entry-points."ocpkit.<family>"]` tables are the one list of built-in
+components (name = "module:object"), and third-party packages add theirs to the same groups in their own
+metadata. A registry resolves a name through the entry points and loads (imports) only what is asked for.
+
+Where ocpkit's own entry points come from:
+- Running from a source checkout (pyproject.toml naming project `ocpkit` next to the package, as in the
+  repository with `PYTHONPATH=.` or an editable install), they are read from that pyproject.toml, so a
+  component declared there is found without (re)installing, and stale ocpkit metadata (an old
+  `ocpkit.egg-info`, an outdated install) is ignored. Needs `tomllib` (Python ≥ 3.11); on 3.10 the
+  installed metadata is used instead.
+- Otherwise (a wheel install) from the installed distribution's metadata, as for any package.
+
+Entry points are scanned anew whenever a name is not yet loaded (importlib.metadata notices new
+distributions on sys.path), so components installed after the first lookup are found; loaded components are
+cached. `register` adds a component at run time without packaging (a notebook, a test).
+"""
 
 from __future__ import annotations
 
-from importlib.metadata import entry_points
+import functools
+import inspect
+from importlib.metadata import EntryPoint, entry_points
+from pathlib import Path
 from typing import Generic, TypeVar
 
 from ocpkit.errors import RegistryError
 
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10: no TOML reader in the standard library
+    tomllib = None
+
 T = TypeVar("T")
+
+_PYPROJECT = Path(__file__).resolve().parent.parent / "pyproject.toml"
+
+
+@functools.cache
+def _source_entry_points() -> tuple[EntryPoint, ...] | None:
+    """ocpkit's own entry points from the source checkout's pyproject.toml; None when not in a checkout."""
+    if tomllib is None or not _PYPROJECT.is_file():
+        return None
+    project = tomllib.loads(_PYPROJECT.read_text(encoding="utf-8")).get("project", {})
+    if project.get("name") != "ocpkit":
+        return None
+    return tuple(EntryPoint(name, value, group)
+                 for group, points in project.get("entry-points", {}).items() for name, value in points.items())
+
+
+def _entry_points(group: str) -> list[EntryPoint]:
+    """Every entry point of `group`: ocpkit's own (see the module docstring), then other packages'."""
+    installed = entry_points(group=group)
+    own = _source_entry_points()
+    if own is None:
+        return list(installed)
+    return [p for p in own if p.group == group] + [p for p in installed if p.dist.name != "ocpkit"]
 
 
 class Registry(Generic[T]):
-    """Components of one family (e.g. transcriptions) keyed by a short name.
-
-    Built-in components register themselves with `register`; others are found in the entry-point
-    group `group` (e.g. `ocpkit.transcriptions`), loaded on first lookup of an unknown name.
-    """
+    """Components of one family (e.g. transcriptions) keyed by a short name, from entry-point group `group`."""
 
     def __init__(self, family: str, group: str) -> None:
         self.family, self.group = family, group
         self._items: dict[str, T] = {}
 
     def register(self, name: str, item: T) -> T:
-        """Add `item` under `name`; returns it, so it can decorate a class."""
+        """Add `item` under `name` at run time; returns it, so it can decorate a class."""
         self._items[name] = item
         return item
 
     def get(self, name: str) -> T:
         """The component called `name`; RegistryError lists the known names if there is none."""
         if name not in self._items:
-            for point in entry_points(group=self.group):
-                if point.name == name:
-                    self._items[name] = point.load()
-        if name not in self._items:
-            raise RegistryError(f"unknown {self.family} {name!r}; known: {', '.join(self.names())}")
+            values = {p.value: p for p in _entry_points(self.group) if p.name == name}
+            if not values:
+                raise RegistryError(f"unknown {self.family} {name!r}; known: {', '.join(self.names())}")
+            if len(values) > 1:
+                raise RegistryError(f"{self.family} {name!r} is declared more than once: {', '.join(values)}")
+            self._items[name] = next(iter(values.values())).load()
         return self._items[name]
 
     def names(self) -> list[str]:
-        """Registered names, built-in and from entry points."""
-        return sorted(set(self._items) | {p.name for p in entry_points(group=self.group)})
+        """Every known name: from entry points and registered at run time."""
+        return sorted(set(self._items) | {p.name for p in _entry_points(self.group)})
+
+    def description(self, name: str) -> str:
+        """One line about the component `name`: its docstring's first paragraph (loads the component)."""
+        doc = inspect.getdoc(self.get(name)) or ""
+        return " ".join(doc.split("\n\n")[0].split())

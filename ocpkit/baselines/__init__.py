@@ -1,7 +1,5 @@
-"""Baseline planners to compare against: importing this package registers them with `ocpkit.plan`.
+"""Baseline planners to compare against, registered with `ocpkit.plan` through the `ocpkit.planners` entry points.
 
 `ompl-toppra`: the path–velocity decomposition (OMPL path, TOPP-RA timing); needs `ompl` and `toppra`,
-imported on first use.
+imported on first use. Its motion also seeds the simultaneous planner (`guess="ompl"`, group `ocpkit.guesses`).
 """
-
-from ocpkit.baselines import ompl_toppra  # noqa: F401  (registers "ompl-toppra")

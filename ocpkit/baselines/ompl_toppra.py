@@ -54,7 +54,7 @@ import pinocchio as pin
 
 from ocpkit.errors import RegistryError
 from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.planner import GUESSES, PLANNERS, Plan, PlanStats
+from ocpkit.planner import Plan, PlanStats
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot
 from ocpkit.scenario import validate
@@ -377,5 +377,3 @@ def ompl_guess(problem: Problem, nlp: NLP, **baseline_options: Any) -> np.ndarra
     return nlp.encode(baseline.trajectory)
 
 
-PLANNERS.register("ompl-toppra", plan_ompl_toppra)
-GUESSES.register("ompl", ompl_guess)

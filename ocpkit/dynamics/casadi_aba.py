@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import casadi as ca
 
-from ocpkit.dynamics.base import DYNAMICS
 from ocpkit.dynamics.spatial import SymbolicModel
 from ocpkit.robots import Robot
 
@@ -61,5 +60,3 @@ class CasadiRnea(CasadiAba):
         return (self.symbolic.inverse_dynamics(q, qd, qdd) - tau_rigid) / ca.DM(self.robot.tau_max)
 
 
-DYNAMICS.register(CasadiAba.name, CasadiAba)
-DYNAMICS.register(CasadiRnea.name, CasadiRnea)

@@ -1,6 +1,5 @@
-"""NLP solvers (registry `SOLVERS`): `ipopt` through CasADi."""
+"""NLP solvers (registry `SOLVERS`, entry-point group `ocpkit.solvers`): `ipopt` through CasADi."""
 
-from ocpkit.solvers import casadi_nlpsol  # noqa: F401  (registers the built-in solvers)
 from ocpkit.solvers.base import SOLVERS, Solver, SolverResult, SolverStatus
 
 __all__ = ["SOLVERS", "Solver", "SolverResult", "SolverStatus"]

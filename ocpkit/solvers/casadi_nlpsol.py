@@ -7,7 +7,7 @@ import time
 import casadi as ca
 import numpy as np
 
-from ocpkit.solvers.base import SOLVERS, Solver, SolverResult, SolverStatus
+from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
 from ocpkit.transcription.base import NLP
 
 _IPOPT_STATUS = {
@@ -51,4 +51,3 @@ class Ipopt(Solver):
                             int(stats.get("iter_count", 0)), wall, message, stats)
 
 
-SOLVERS.register(Ipopt.name, Ipopt)

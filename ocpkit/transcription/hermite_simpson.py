@@ -39,7 +39,6 @@ from typing import Any
 import casadi as ca
 
 from ocpkit.transcription.assembly import Assembly
-from ocpkit.transcription.base import TRANSCRIPTIONS
 from ocpkit.transcription.mesh import Local, MeshNLP, MeshTranscription, Node
 
 
@@ -91,4 +90,3 @@ class HermiteSimpson(MeshTranscription):
     nlp = HermiteSimpsonNLP
 
 
-TRANSCRIPTIONS.register(HermiteSimpson.name, HermiteSimpson)

@@ -1,4 +1,5 @@
-"""Chebyshev–Lobatto polynomial tools on the normalized interval s ∈ [-1, 1].
+"""Chebyshev–Lobatto polynomial tools on the normalized interval s ∈ [-1, 1], and the barycentric formulas
+every node family (`NodeFamily`: Chebyshev here, Legendre–Gauss–Lobatto in lgl.py) shares.
 
 Knot i sits at s_i = cos(iπ/N), i = 0..N, so knot 0 is s = 1 (t = t_f) and knot N is s = -1 (t = 0),
 with t = t_f (s + 1) / 2. References: Trefethen, *Spectral Methods in MATLAB* (cheb, clencurt) and
@@ -7,7 +8,55 @@ Berrut & Trefethen, *Barycentric Lagrange Interpolation*, SIAM Review 46 (2004).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Callable
+
 import numpy as np
+
+
+def barycentric_differentiation(nodes: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """D, shape (n+1, n+1), for distinct `nodes` with barycentric `weights`: D_ij = (w_j / w_i) / (s_i − s_j)
+    off the diagonal, so (D f)_i = f'(s_i) exactly for every polynomial f of degree ≤ n."""
+    ds = nodes[:, None] - nodes[None, :] + np.eye(len(nodes))
+    d = (weights[None, :] / weights[:, None]) / ds
+    d -= np.diag(d.sum(axis=1))  # negative-sum trick: rows of D annihilate constants
+    return d
+
+
+def barycentric_interpolation(nodes: np.ndarray, weights: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """L, shape (len(s), n+1): L @ f_nodes is the degree-n interpolant at points s (second barycentric form)."""
+    s = np.atleast_1d(np.asarray(s, dtype=float))
+    diff = s[:, None] - nodes[None, :]
+    exact = np.isclose(diff, 0.0, atol=1e-14, rtol=0.0)
+    diff[exact] = 1.0
+    terms = weights / diff
+    matrix = terms / terms.sum(axis=1, keepdims=True)
+    hit_rows = exact.any(axis=1)
+    matrix[hit_rows] = exact[hit_rows].astype(float)
+    return matrix
+
+
+@dataclass(frozen=True)
+class NodeFamily:
+    """A pseudospectral node family: for n intervals, the n + 1 points s_i (decreasing from 1 to -1, both ends
+    included), their barycentric weights and their quadrature weights (Σ w_i f(s_i) ≈ ∫_{-1}^{1} f ds)."""
+
+    name: str
+    points: Callable[[int], np.ndarray]
+    barycentric_weights: Callable[[int], np.ndarray]
+    quadrature_weights: Callable[[int], np.ndarray]
+
+    def differentiation(self, n: int) -> np.ndarray:
+        """D, shape (n+1, n+1): exact derivative at the points of the degree-n interpolant."""
+        return barycentric_differentiation(self.points(n), self.barycentric_weights(n))
+
+    def interpolation(self, n: int, s: np.ndarray) -> np.ndarray:
+        """L, shape (len(s), n+1): the degree-n interpolant of the point values at s."""
+        return barycentric_interpolation(self.points(n), self.barycentric_weights(n), s)
+
+    def derivative(self, n: int, s: np.ndarray) -> np.ndarray:
+        """L', shape (len(s), n+1): d/ds of the degree-n interpolant at s."""
+        return self.interpolation(n, s) @ self.differentiation(n)
 
 
 def lobatto_points(n: int) -> np.ndarray:
@@ -26,14 +75,7 @@ def barycentric_weights(n: int) -> np.ndarray:
 
 def differentiation_matrix(n: int) -> np.ndarray:
     """D, shape (n+1, n+1), with (D f)_i = f'(s_i) exactly for every polynomial f of degree ≤ n."""
-    s = lobatto_points(n)
-    c = np.ones(n + 1)
-    c[[0, -1]] = 2.0
-    c *= (-1.0) ** np.arange(n + 1)
-    ds = s[:, None] - s[None, :] + np.eye(n + 1)
-    d = np.outer(c, 1.0 / c) / ds
-    d -= np.diag(d.sum(axis=1))  # negative-sum trick: rows of D annihilate constants
-    return d
+    return barycentric_differentiation(lobatto_points(n), barycentric_weights(n))
 
 
 def clenshaw_curtis_weights(n: int) -> np.ndarray:
@@ -57,19 +99,12 @@ def clenshaw_curtis_weights(n: int) -> np.ndarray:
 
 def interpolation_matrix(n: int, s: np.ndarray) -> np.ndarray:
     """L, shape (len(s), n+1): L @ f_knots is the degree-n interpolant at points s (barycentric form)."""
-    nodes = lobatto_points(n)
-    w = barycentric_weights(n)
-    s = np.atleast_1d(np.asarray(s, dtype=float))
-    diff = s[:, None] - nodes[None, :]
-    exact = np.isclose(diff, 0.0, atol=1e-14, rtol=0.0)
-    diff[exact] = 1.0
-    terms = w / diff
-    matrix = terms / terms.sum(axis=1, keepdims=True)
-    hit_rows = exact.any(axis=1)
-    matrix[hit_rows] = exact[hit_rows].astype(float)
-    return matrix
+    return barycentric_interpolation(lobatto_points(n), barycentric_weights(n), s)
 
 
 def derivative_matrix(n: int, s: np.ndarray) -> np.ndarray:
     """L', shape (len(s), n+1): L' @ f_knots is d/ds of the degree-n interpolant at points s."""
     return interpolation_matrix(n, s) @ differentiation_matrix(n)
+
+
+CHEBYSHEV = NodeFamily("Chebyshev–Lobatto", lobatto_points, barycentric_weights, clenshaw_curtis_weights)

@@ -32,7 +32,6 @@ from typing import Any
 import casadi as ca
 
 from ocpkit.transcription.assembly import Assembly
-from ocpkit.transcription.base import TRANSCRIPTIONS
 from ocpkit.transcription.mesh import Local, MeshNLP, MeshTranscription, Node
 
 
@@ -70,4 +69,3 @@ class Trapezoidal(MeshTranscription):
     nlp = TrapezoidalNLP
 
 
-TRANSCRIPTIONS.register(Trapezoidal.name, Trapezoidal)
