@@ -18,7 +18,8 @@ def _plan_command(args: argparse.Namespace) -> int:
     problem = load_scenario(args.scenario)
     if args.mu is not None:
         problem = dataclasses.replace(problem, mu=args.mu)
-    result = plan(problem, planner=args.planner, transcription=args.transcription, knots=args.knots,
+    segments = {"transcription_options": {"segments": args.segments}} if args.segments else {}
+    result = plan(problem, planner=args.planner, transcription=args.transcription, knots=args.knots, **segments,
                   dynamics=args.dynamics, solver=args.solver)
     v = result.verification
     print(f"{problem.name}: status {result.status}, t_f = {result.trajectory.tf:.3f} s "
@@ -64,6 +65,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--planner", default="simultaneous")
     p.add_argument("--transcription", default="chebyshev")
     p.add_argument("--knots", type=int, default=12, help="number of knot intervals N (default 12)")
+    p.add_argument("--segments", type=int, help="pseudospectral segments K (chebyshev, lgl; default 1)")
     p.add_argument("--dynamics", default="casadi-rnea", help="casadi-rnea (default, inverse form) or casadi (ABA)")
     p.add_argument("--solver", default="ipopt")
     p.add_argument("--mu", type=float, default=None, help="jerk weight μ (default: the scenario's)")

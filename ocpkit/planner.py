@@ -18,6 +18,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ocpkit.errors import OptionError
 from ocpkit.problem import Problem
 from ocpkit.registry import Registry
 from ocpkit.solvers.base import SOLVERS, Solver, SolverStatus
@@ -70,17 +71,25 @@ _BUILDS: dict[tuple, tuple[NLP, Solver, float]] = {}
 def prepared(problem: Problem, transcription: str, dynamics: str, solver: str,
              transcription_options: dict, solver_options: dict) -> tuple[NLP, Solver, float]:
     """The cached (NLP, prepared solver, set-up seconds) for this problem's shape; builds on first use."""
-    method = TRANSCRIPTIONS.get(transcription)(**transcription_options)
+    method = _construct(TRANSCRIPTIONS.get(transcription), transcription, transcription_options)
     key = (method.shape_key(problem, dynamics), solver, tuple(sorted(solver_options.items())))
     if key not in _BUILDS:
         start = time.perf_counter()
         nlp = method.build(problem, dynamics)
-        nlp_solver = SOLVERS.get(solver)(**solver_options)
+        nlp_solver = _construct(SOLVERS.get(solver), solver, solver_options)
         nlp_solver.prepare(nlp)
         _BUILDS[key] = (nlp, nlp_solver, time.perf_counter() - start)
         return _BUILDS[key]
     nlp, nlp_solver, _ = _BUILDS[key]
     return nlp, nlp_solver, 0.0
+
+
+def _construct(component: Callable, name: str, options: dict) -> Any:
+    """`component(**options)`; an option it does not take is the user's mistake, reported as an OptionError."""
+    try:
+        return component(**options)
+    except TypeError as exc:
+        raise OptionError(f"{name}: {exc} (options given: {sorted(options)})") from exc
 
 
 def plan(problem: Problem, planner: str = "simultaneous", **options: Any) -> Plan:

@@ -121,3 +121,9 @@ def test_cli_runs_the_baseline_and_reports_what_it_violates(capsys):
     code = main(["plan", str(CASES[2]), "--planner", "ompl-toppra"])
     printed = capsys.readouterr().out
     assert code == 1 and "status violated" in printed and "torque_rate" in printed
+
+
+def test_an_option_a_transcription_does_not_take_is_a_one_line_error(capsys):
+    assert main(["plan", str(CASES[1]), "--transcription", "trapezoidal", "--segments", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: trapezoidal: ") and "'segments'" in err
