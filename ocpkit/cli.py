@@ -36,9 +36,14 @@ def _plan_command(args: argparse.Namespace) -> int:
 
 
 def _bench_command(args: argparse.Namespace) -> int:
+    if args.suite == "convergence":
+        from ocpkit.bench.convergence import DEFAULT_CASE, run_convergence
+
+        run_convergence(Path(args.out or "results/convergence"), case=Path(args.case or DEFAULT_CASE))
+        return 0
     from ocpkit.bench.paper import run_paper_benchmark
 
-    run_paper_benchmark(Path(args.scenarios), Path(args.out), repeats=args.repeats,
+    run_paper_benchmark(Path(args.scenarios), Path(args.out or "results/paper"), repeats=args.repeats,
                         hard=Path(args.hard) if args.hard else None)
     return 0
 
@@ -72,11 +77,14 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", help="write the trajectory JSON here")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite")
-    b.add_argument("suite", choices=["paper"])
+    b.add_argument("suite", choices=["paper", "convergence"],
+                   help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
                    "('' to skip it)")
-    b.add_argument("--out", default="results/paper", help="output folder (results.csv, trajectories/)")
+    b.add_argument("--out", default=None, help="output folder (default results/SUITE): results.csv and "
+                   "trajectories/, or convergence.csv and convergence.png")
+    b.add_argument("--case", default=None, help="convergence: the scenario file (default scenarios/paper/case2.yaml)")
     b.add_argument("--repeats", type=int, default=5, help="solves per plan; the median is reported")
     b.set_defaults(run=_bench_command)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, solvers, "
