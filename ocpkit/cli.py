@@ -41,10 +41,12 @@ def _bench_command(args: argparse.Namespace) -> int:
 
         run_convergence(Path(args.out or "results/convergence"), case=Path(args.case or DEFAULT_CASE))
         return 0
-    from ocpkit.bench.paper import run_paper_benchmark
+    from ocpkit.bench.paper import KNOTS, run_paper_benchmark
 
     run_paper_benchmark(Path(args.scenarios), Path(args.out or "results/paper"), repeats=args.repeats,
-                        hard=Path(args.hard) if args.hard else None)
+                        hard=Path(args.hard) if args.hard else None, transcription=args.transcription,
+                        knots=tuple(args.knots) if args.knots else KNOTS,
+                        transcription_options={"segments": args.segments} if args.segments else None)
     return 0
 
 
@@ -86,6 +88,9 @@ def parser() -> argparse.ArgumentParser:
                    "trajectories/, or convergence.csv and convergence.png")
     b.add_argument("--case", default=None, help="convergence: the scenario file (default scenarios/paper/case2.yaml)")
     b.add_argument("--repeats", type=int, default=5, help="solves per plan; the median is reported")
+    b.add_argument("--transcription", default="chebyshev", help="paper: the simultaneous planner's transcription")
+    b.add_argument("--knots", type=int, nargs="+", help="paper: knot counts N (default 12 8)")
+    b.add_argument("--segments", type=int, help="paper: pseudospectral segments K (chebyshev, lgl)")
     b.set_defaults(run=_bench_command)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, solvers, "
                              "planners, guesses) with one line each")

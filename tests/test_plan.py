@@ -127,3 +127,11 @@ def test_an_option_a_transcription_does_not_take_is_a_one_line_error(capsys):
     assert main(["plan", str(CASES[1]), "--transcription", "trapezoidal", "--segments", "2"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: trapezoidal: ") and "'segments'" in err
+
+
+def test_paper_benchmark_takes_another_transcription(tmp_path, capsys):
+    shutil.copy(CASES[1], tmp_path / CASES[1].name)
+    rows = run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1, dynamics=("casadi-rnea",),
+                               transcription="hermite-simpson", knots=(10,))
+    assert (rows[0]["transcription"], rows[0]["knots"], rows[0]["status"]) == ("hermite-simpson", 10, "verified")
+    assert "hermite-simpson + ipopt" in capsys.readouterr().out

@@ -46,17 +46,21 @@ def measure(problem: Problem, repeats: int, **options) -> Measured:
 
 
 def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
-                        dynamics: tuple[str, ...] = ("casadi-rnea", "casadi"), hard: Path | None = None) -> list[dict]:
+                        dynamics: tuple[str, ...] = ("casadi-rnea", "casadi"), hard: Path | None = None,
+                        transcription: str = "chebyshev", knots: tuple[int, ...] = KNOTS,
+                        transcription_options: dict | None = None) -> list[dict]:
     """Solve every case at every knot count with every dynamics form and with the baseline; print the
     tables; write results.csv and trajectories/. With `hard` (a folder of scenarios), also compare the
-    straight-line and the OMPL initial guess on the paper cases and those."""
+    straight-line and the OMPL initial guess on the paper cases and those. The simultaneous planner uses
+    `transcription` (with `transcription_options`); the single-knot-count comparisons use knots[0]."""
     problems = _load_all(Path(scenarios))
+    method = {"transcription": transcription, "transcription_options": transcription_options or {}}
     rows, simultaneous, baseline = [], {}, {}
     for form in dynamics:
-        for knots in KNOTS:
+        for n in knots:
             for problem in problems:
-                m = measure(problem, repeats, knots=knots, dynamics=form)
-                simultaneous[form, problem.name, knots] = m
+                m = measure(problem, repeats, knots=n, dynamics=form, **method)
+                simultaneous[form, problem.name, n] = m
                 rows.append(result_row("paper", problem.name, m.plan, m.solve_time, m.setup_time))
                 if form == dynamics[0]:
                     _write_trajectory(out, problem, m.plan)
@@ -65,15 +69,17 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
         rows.append(result_row("paper", problem.name, m.plan, m.solve_time, m.setup_time))
         _write_trajectory(out, problem, m.plan)
     for problem in _matched_to_baseline(problems):
-        m = simultaneous["matched", problem.name, 12] = measure(problem, 1, knots=12, dynamics=dynamics[0])
+        m = simultaneous["matched", problem.name, knots[0]] = measure(problem, 1, knots=knots[0],
+                                                                      dynamics=dynamics[0], **method)
         rows.append(result_row("matched-to-baseline", problem.name, m.plan, m.solve_time, m.setup_time))
     first = {(c, k): m for (f, c, k), m in simultaneous.items() if f == dynamics[0]}
-    print(_paper_table(problems, first, dynamics[0]))
-    print(_comparison(problems, simultaneous, dynamics))
+    options = "".join(f" {k}={v}" for k, v in method["transcription_options"].items())
+    print(_paper_table(problems, first, f"{transcription}{options} + ipopt, dynamics {dynamics[0]}", knots))
+    print(_comparison(problems, simultaneous, dynamics, knots))
     matched = {c: m for (f, c, k), m in simultaneous.items() if f == "matched"}
-    print(_baseline_table(problems, first, baseline, matched))
+    print(_baseline_table(problems, {c: m for (c, k), m in first.items() if k == knots[0]}, baseline, matched))
     if hard is not None:
-        seeding = {(p.name, guess): measure(p, 1, knots=12, dynamics=dynamics[0], guess=guess)
+        seeding = {(p.name, guess): measure(p, 1, knots=knots[0], dynamics=dynamics[0], guess=guess, **method)
                    for p in problems + _load_all(Path(hard)) for guess in ("line", "ompl")}
         rows += [result_row(f"seeding-{guess}", name, m.plan, m.solve_time, m.setup_time)
                  for (name, guess), m in seeding.items()]
@@ -113,33 +119,38 @@ def _write_csv(path: Path, rows: list[dict]) -> None:
         writer.writerows(rows)
 
 
-def _paper_table(problems: list[Problem], measured: dict, dynamics: str) -> str:
+def _paper_table(problems: list[Problem], measured: dict, label: str, counts: tuple[int, ...]) -> str:
     head = f"{'time [s]':<20}{'knots':>6}" + "".join(f"{p.name:>{WIDTH}}" for p in problems)
-    lines = [f"Table II, simultaneous planner (chebyshev + ipopt, dynamics {dynamics}): ours (paper) "
-             "[velocity lower bound]", head, "-" * len(head)]
-    for knots in KNOTS:
-        cells = [f"{measured[p.name, knots].plan.trajectory.tf:.2f} ({PAPER_TF[knots][k]:.2f}) "
+    lines = [f"Table II, simultaneous planner ({label}): ours (paper) [velocity lower bound]", head, "-" * len(head)]
+    for knots in counts:
+        cells = [f"{measured[p.name, knots].plan.trajectory.tf:.2f} {_paper(PAPER_TF, knots, k)} "
                  f"[{p.velocity_lower_bound():.2f}]" for k, p in enumerate(problems)]
         lines.append(_row("motion time t_f", knots, cells))
-    for knots in KNOTS:
-        cells = [f"{measured[p.name, knots].solve_time:.3f} ({PAPER_SOLVE[knots][k]:.2f})" for k, p in enumerate(problems)]
+    for knots in counts:
+        cells = [f"{measured[p.name, knots].solve_time:.3f} {_paper(PAPER_SOLVE, knots, k)}" for k, p in enumerate(problems)]
         lines.append(_row("computation time", knots, cells))
-    for knots in KNOTS:
+    for knots in counts:
         lines.append(_row("status", knots, [measured[p.name, knots].plan.status for p in problems]))
     return "\n".join(lines)
 
 
-def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ...]) -> str:
+def _paper(figures: dict, knots: int, case: int) -> str:
+    """The paper's figure for this knot count and case, in parentheses; (-) where the paper has none."""
+    values = figures.get(knots, [])
+    return f"({values[case]:.2f})" if case < len(values) else "(-)"
+
+
+def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ...], counts: tuple[int, ...]) -> str:
     lines = ["", f"{'dynamics':<14}{'knots':>6}{'median computation':>20}{'vs paper':>10}{'set-up':>9}"
              f"{'paper set-up':>14}{'verified':>10}"]
     for form in dynamics:
-        for knots in KNOTS:
+        for knots in counts:
             cases = [measured[form, p.name, knots] for p in problems]
             median = statistics.median(m.solve_time for m in cases)
             setup = max(m.setup_time for m in cases)
-            speedup = statistics.median(PAPER_SOLVE[knots]) / median
+            speedup = f"{statistics.median(PAPER_SOLVE[knots]) / median:.1f}x" if knots in PAPER_SOLVE else "-"
             verified = sum(m.plan.ok for m in cases)
-            lines.append(f"{form:<14}{knots:>6}{median:>19.3f}s{speedup:>9.1f}x{setup:>8.2f}s{PAPER_SETUP:>13.1f}s"
+            lines.append(f"{form:<14}{knots:>6}{median:>19.3f}s{speedup:>10}{setup:>8.2f}s{PAPER_SETUP:>13.1f}s"
                          f"{verified:>8}/{len(cases)}")
     return "\n".join(lines)
 
@@ -151,11 +162,11 @@ def _baseline_table(problems: list[Problem], simultaneous: dict, baseline: dict,
     stat = lambda key: [baseline[p.name].plan.stats.extra.get(key, 0.0) for p in problems]  # noqa: E731
     cells = {
         "t_f baseline": [f"{baseline[p.name].plan.trajectory.tf:.3f}" for p in problems],
-        "t_f simultaneous (12)": [f"{simultaneous[p.name, 12].plan.trajectory.tf:.3f}" for p in problems],
-        "ratio sim / baseline": [f"{simultaneous[p.name, 12].plan.trajectory.tf / baseline[p.name].plan.trajectory.tf:.3f}"
+        "t_f simultaneous": [f"{simultaneous[p.name].plan.trajectory.tf:.3f}" for p in problems],
+        "ratio sim / baseline": [f"{simultaneous[p.name].plan.trajectory.tf / baseline[p.name].plan.trajectory.tf:.3f}"
                                  for p in problems],
-        "t_f sim, matched (12)": [f"{matched[p.name].plan.trajectory.tf:.3f} {matched[p.name].plan.status[:3]}"
-                                  for p in problems],
+        "t_f sim, matched": [f"{matched[p.name].plan.trajectory.tf:.3f} {matched[p.name].plan.status[:3]}"
+                             for p in problems],
         "ratio matched / baseline": [f"{matched[p.name].plan.trajectory.tf / baseline[p.name].plan.trajectory.tf:.3f}"
                                      for p in problems],
         "computation [s]": [f"{baseline[p.name].solve_time:.3f}" for p in problems],
