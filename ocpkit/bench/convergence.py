@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ocpkit.bench.paper import measure
+from ocpkit.bench.paper import measure, write_csv
 from ocpkit.problem import Problem
 from ocpkit.scenario import load_scenario
 from ocpkit.scene import Scene
@@ -112,23 +112,14 @@ def run_convergence(out: Path, case: Path = DEFAULT_CASE, sweep: dict = SWEEP, r
         for transcription, counts in sweep.items():
             if method(transcription)[0] in available:
                 rows += [solve_point(variant, transcription, n, tf_ref) for n in counts]
-    write_rows(out / "convergence.csv", rows)
+    write_csv(out / "convergence.csv", rows, COLUMNS)
     plot_convergence(rows, out / "convergence.png")
     print(table(rows))
     return rows
 
 
-def write_rows(path: Path, rows: list[dict]) -> None:
-    """The study's rows as CSV with `COLUMNS`."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=COLUMNS)
-        writer.writeheader()
-        writer.writerows(rows)
-
-
 def read_rows(path: Path) -> list[dict]:
-    """Rows written by `write_rows`, numbers parsed back."""
+    """Rows written by `run_convergence` (convergence.csv), numbers parsed back."""
     with Path(path).open(newline="") as handle:
         rows = list(csv.DictReader(handle))
     for row in rows:

@@ -84,7 +84,7 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
         rows += [result_row(f"seeding-{guess}", name, m.plan, m.solve_time, m.setup_time)
                  for (name, guess), m in seeding.items()]
         print(_seeding_table(seeding))
-    _write_csv(out / "results.csv", rows)
+    write_csv(out / "results.csv", rows)
     print(f"machine: {_cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
           f"computation times are medians of {repeats} runs per plan (seeding: 1 run)")
     return rows
@@ -111,10 +111,11 @@ def _write_trajectory(out: Path, problem: Problem, result: Plan) -> None:
     write_json(out / "trajectories" / name, result.trajectory, trajectory_header(problem, result))
 
 
-def _write_csv(path: Path, rows: list[dict]) -> None:
+def write_csv(path: Path, rows: list[dict], columns: tuple[str, ...] = RESULT_COLUMNS) -> None:
+    """`rows` as CSV with `columns`, creating the folder."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=RESULT_COLUMNS)
+        writer = csv.DictWriter(handle, fieldnames=columns)
         writer.writeheader()
         writer.writerows(rows)
 

@@ -24,6 +24,8 @@ and this module assembles the same NLP around it for both:
 
 from __future__ import annotations
 
+from abc import abstractmethod
+
 from typing import Any, Callable, NamedTuple
 
 import casadi as ca
@@ -87,16 +89,19 @@ class MeshNLP(NLP):
     check_default: float = 0.5  # σ of every interval's check before any refinement
 
     @staticmethod
+    @abstractmethod
     def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: Node | None) -> None:
-        raise NotImplementedError
+        """Add the interval's defect rows to `a` (interval length h, knots x0, x1, midpoint xm)."""
 
     @staticmethod
+    @abstractmethod
     def interpolate(x0: Node, x1: Node, xm: Node | None, h: Any, s: Any) -> Local:
-        raise NotImplementedError
+        """The interval's own interpolant at σ = s ∈ [0, 1] (CasADi symbols or NumPy arrays)."""
 
     @staticmethod
+    @abstractmethod
     def jerk_integral(x0: Node, x1: Node, xm: Node | None, weights: ca.DM) -> ca.SX:
-        raise NotImplementedError
+        """∫ jerkᵀ Q jerk over the interval divided by h, by the method's quadrature (weights = diag Q)."""
 
     def __init__(self, problem: Problem, dynamics_name: str, knots: int, margin: float, shape_key: tuple) -> None:
         robot = problem.robot
