@@ -37,6 +37,11 @@ class Dynamics(Protocol):
     def sphere_centers(self, q: ca.SX) -> ca.SX:
         """World positions (M, 3) of the robot's collision spheres."""
 
+    def lift(self, fields: dict) -> dict:
+        """The finished NLP's fields (x, p, f, g, lbg, ubg, shape_key) as the solver should get them: unchanged
+        for symbolic backends; a backend that cannot live in an SX graph (a callback) rewrites them in MX
+        and sets exact_hessian=False."""
+
 
 DYNAMICS: Registry[type] = Registry("dynamics backend", "ocpkit.dynamics")
 

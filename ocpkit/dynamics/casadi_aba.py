@@ -38,6 +38,10 @@ class CasadiAba:
         """qdd − ABA(q, qd, tau_rigid), rad/s²."""
         return qdd - self.symbolic.forward_dynamics(q, qd, tau_rigid)
 
+    def lift(self, fields: dict) -> dict:
+        """Unchanged: the whole NLP stays in SX."""
+        return fields
+
     def sphere_centers(self, q: ca.SX) -> ca.SX:
         """Sphere centres (M, 3) by forward kinematics, metres."""
         placements = self.symbolic.joint_placements(q)

@@ -1,8 +1,21 @@
-"""Solvers reached through CasADi's nlpsol: `ipopt` (interior point, exact Hessian, MUMPS)."""
+"""Solvers reached through CasADi's nlpsol: `ipopt` (interior point, exact Hessian, MUMPS), `sqpmethod`
+(SQP, exact Hessian, a CasADi QP solver per step), `blocksqp` (SQP with quasi-Newton Hessian blocks) and
+`fatrop` (structure-exploiting interior point, given our NLP as one stage).
+
+All share `CasadiNlpsol`: one nlpsol per NLP shape, limits and status mapping from `solver.stats()`
+(`success`, `return_status`, `iter_count`, `unified_return_status`), and a CasADi RuntimeError during a
+solve reported as status `failed` with its message instead of an exception.
+
+Time limits: IPOPT has its own `max_wall_time`; sqpmethod stops through CasADi's `iteration_callback`
+(checked once per SQP iteration, reported as `User_Requested_Stop`). blocksqp and fatrop ignore the
+iteration callback and have no wall-time option, so they cannot be interrupted: an unconverged solve that
+overran `max_wall_time` is reported as `time_limit` after the fact.
+"""
 
 from __future__ import annotations
 
 import time
+from abc import abstractmethod
 
 import casadi as ca
 import numpy as np
@@ -10,44 +23,213 @@ import numpy as np
 from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
 from ocpkit.transcription.base import NLP
 
-_IPOPT_STATUS = {
-    "Solve_Succeeded": SolverStatus.CONVERGED,
-    "Solved_To_Acceptable_Level": SolverStatus.CONVERGED,
-    "Infeasible_Problem_Detected": SolverStatus.INFEASIBLE,
-    "Maximum_Iterations_Exceeded": SolverStatus.ITERATION_LIMIT,
-    "Maximum_WallTime_Exceeded": SolverStatus.TIME_LIMIT,
-    "Maximum_CpuTime_Exceeded": SolverStatus.TIME_LIMIT,
+_UNIFIED_STATUS = {
+    "SOLVER_RET_SUCCESS": SolverStatus.CONVERGED,
+    "SOLVER_RET_INFEASIBLE": SolverStatus.INFEASIBLE,
+    "SOLVER_RET_LIMITED": SolverStatus.ITERATION_LIMIT,
 }
 
 
-class Ipopt(Solver):
-    """IPOPT with exact Hessian by CasADi AD and the MUMPS linear solver; extra keyword options go to
-    IPOPT verbatim (e.g. tol=1e-8)."""
+def _hessian(nlp: NLP) -> str:
+    """The `hessian_approximation` option for this NLP: "exact" unless its derivatives stop at first order."""
+    return "exact" if nlp.exact_hessian else "limited-memory"
 
-    name = "ipopt"
 
-    def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, **ipopt_options) -> None:
-        self.options = {"hessian_approximation": "exact", "linear_solver": "mumps", "print_level": 0,
-                        "sb": "yes", "tol": 1e-6, "mu_strategy": "adaptive", "max_iter": max_iterations,
-                        "max_wall_time": max_wall_time, **ipopt_options}
-        self._prepared: dict[tuple, ca.Function] = {}
+class _Deadline(ca.Callback):
+    """nlpsol iteration callback that asks the solver to stop once `deadline` (time.perf_counter s) passed."""
+
+    def __init__(self, n_w: int, n_g: int, n_p: int) -> None:
+        ca.Callback.__init__(self)
+        self.sizes = {"x": n_w, "lam_x": n_w, "g": n_g, "lam_g": n_g, "lam_p": n_p, "f": 1}
+        self.deadline = np.inf
+        self.construct("deadline", {})
+
+    def get_n_in(self) -> int:
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self) -> int:
+        return 1
+
+    def get_name_in(self, i: int) -> str:
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i: int) -> str:
+        return "stop"
+
+    def get_sparsity_in(self, i: int) -> ca.Sparsity:
+        return ca.Sparsity.dense(self.sizes[ca.nlpsol_out(i)], 1)
+
+    def eval(self, arg: list) -> list:
+        return [1 if time.perf_counter() > self.deadline else 0]
+
+
+class CasadiNlpsol(Solver):
+    """A CasADi nlpsol plugin on the NLP (one compiled solver per NLP shape); subclasses give the plugin
+    name, its options and its return_status table. `max_wall_time` is in seconds."""
+
+    plugin: str
+    statuses: dict = {}
+    """The plugin's `return_status` → our status; statuses not listed go by CasADi's unified status."""
+    stops_by_callback = False
+    """Whether the plugin honours nlpsol's `iteration_callback` (then used for the time limit)."""
+
+    def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0) -> None:
+        self.max_iterations, self.max_wall_time = max_iterations, max_wall_time
+        self._prepared: dict[tuple, tuple[ca.Function, _Deadline | None]] = {}
+
+    @abstractmethod
+    def plugin_options(self, nlp: NLP) -> dict:
+        """nlpsol options of the plugin for this NLP (limits included)."""
 
     def prepare(self, nlp: NLP) -> None:
         if nlp.shape_key not in self._prepared:
             problem = {"x": nlp.x, "p": nlp.p, "f": nlp.f, "g": nlp.g}
-            options = {"ipopt": self.options, "print_time": False, "error_on_fail": False}
-            self._prepared[nlp.shape_key] = ca.nlpsol("ipopt", "ipopt", problem, options)
+            options = {"print_time": False, "error_on_fail": False, **self.plugin_options(nlp)}
+            deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel()) if self.stops_by_callback else None
+            if deadline is not None:
+                options["iteration_callback"] = deadline
+            self._prepared[nlp.shape_key] = (ca.nlpsol(self.name, self.plugin, problem, options), deadline)
 
     def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
               bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
         self.prepare(nlp)
-        solver = self._prepared[nlp.shape_key]
+        solver, deadline = self._prepared[nlp.shape_key]
         start = time.perf_counter()
-        out = solver(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=nlp.lbg, ubg=nlp.ubg)
+        if deadline is not None:
+            deadline.deadline = start + self.max_wall_time
+        try:
+            out = solver(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=nlp.lbg, ubg=nlp.ubg)
+            stats = solver.stats()
+        except RuntimeError as exc:  # a plugin's assertion or failed evaluation: a status, not a crash
+            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
+                                time.perf_counter() - start, str(exc))
         wall = time.perf_counter() - start
-        stats = solver.stats()
-        message = stats.get("return_status", "unknown")
-        return SolverResult(np.asarray(out["x"]).ravel(), _IPOPT_STATUS.get(message, SolverStatus.FAILED),
-                            int(stats.get("iter_count", 0)), wall, message, stats)
+        message = str(stats.get("return_status", stats.get("unified_return_status", "unknown")))
+        return SolverResult(np.asarray(out["x"]).ravel(), self._status(stats, message, wall),
+                            self.iterations(stats), wall, message, stats)
+
+    def iterations(self, stats: dict) -> int:
+        """Iterations the plugin took, from its stats."""
+        return int(stats.get("iter_count") or 0)
+
+    def _status(self, stats: dict, message: str, wall: float) -> SolverStatus:
+        """Our status from the plugin's stats: its own table, then CasADi's unified status and the limits."""
+        if message in self.statuses:
+            return self.statuses[message]
+        if stats.get("success"):
+            return SolverStatus.CONVERGED
+        if wall > self.max_wall_time:
+            return SolverStatus.TIME_LIMIT
+        if self.iterations(stats) >= self.max_iterations:
+            return SolverStatus.ITERATION_LIMIT
+        return _UNIFIED_STATUS.get(stats.get("unified_return_status"), SolverStatus.FAILED)
 
 
+class Ipopt(CasadiNlpsol):
+    """IPOPT with exact Hessian by CasADi AD (L-BFGS when the NLP has none) and the MUMPS linear solver;
+    extra keyword options go to IPOPT verbatim (e.g. tol=1e-8)."""
+
+    name = plugin = "ipopt"
+    statuses = {
+        "Solve_Succeeded": SolverStatus.CONVERGED,
+        "Solved_To_Acceptable_Level": SolverStatus.CONVERGED,
+        "Infeasible_Problem_Detected": SolverStatus.INFEASIBLE,
+        "Maximum_Iterations_Exceeded": SolverStatus.ITERATION_LIMIT,
+        "Maximum_WallTime_Exceeded": SolverStatus.TIME_LIMIT,
+        "Maximum_CpuTime_Exceeded": SolverStatus.TIME_LIMIT,
+    }
+
+    def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, **ipopt_options) -> None:
+        super().__init__(max_iterations, max_wall_time)
+        self.options = {"linear_solver": "mumps", "print_level": 0, "sb": "yes", "tol": 1e-6,
+                        "mu_strategy": "adaptive", "max_iter": max_iterations, "max_wall_time": max_wall_time,
+                        **ipopt_options}
+
+    def plugin_options(self, nlp: NLP) -> dict:
+        return {"ipopt": {"hessian_approximation": _hessian(nlp), **self.options}}
+
+
+_QPSOL_QUIET = {"qpoases": {"printLevel": "none"}, "osqp": {"osqp": {"verbose": False}}}
+"""Per QP solver: options that silence it (all also get error_on_fail False: a failed QP ends the SQP)."""
+
+
+class SqpMethod(CasadiNlpsol):
+    """CasADi's SQP (`sqpmethod`) with exact Hessian (L-BFGS when the NLP has none) and line search.
+
+    `qpsol` names the QP solver: qpoases (dense active set, the default: it converges on small, tight
+    NLPs where osqp's ADMM accuracy does not), osqp (sparse ADMM: about 10x faster on the paper cases at
+    12 knots), proxqp, hpipm. `convexify_strategy` ("regularize", "eigen-clip",
+    "eigen-reflect") convexifies the Lagrangian Hessian: off (None) by default, as the paper cases converge
+    without it and "regularize" stalls case 2 at the iteration limit. The time limit is checked between SQP
+    iterations, so one long QP (qpoases' first, cold-started) can overrun it. Extra keyword options go to
+    sqpmethod verbatim."""
+
+    name = plugin = "sqpmethod"
+    statuses = {
+        "Solve_Succeeded": SolverStatus.CONVERGED,
+        "Maximum_Iterations_Exceeded": SolverStatus.ITERATION_LIMIT,
+        "User_Requested_Stop": SolverStatus.TIME_LIMIT,  # only our deadline callback stops it
+    }
+    stops_by_callback = True
+
+    def __init__(self, max_iterations: int = 200, max_wall_time: float = 60.0, qpsol: str = "qpoases",
+                 convexify_strategy: str | None = None, tol: float = 1e-6, **sqp_options) -> None:
+        super().__init__(max_iterations, max_wall_time)
+        qp_options = {"error_on_fail": False, **_QPSOL_QUIET.get(qpsol, {})}
+        self.options = {"qpsol": qpsol, "qpsol_options": qp_options, "max_iter": max_iterations, "tol_pr": tol,
+                        "tol_du": tol, "print_header": False, "print_iteration": False, "print_status": False,
+                        **sqp_options}
+        if convexify_strategy is not None:
+            self.options["convexify_strategy"] = convexify_strategy
+
+    def plugin_options(self, nlp: NLP) -> dict:
+        return {"hessian_approximation": _hessian(nlp), **self.options}
+
+
+class BlockSqp(CasadiNlpsol):
+    """blockSQP (Janka et al.) through CasADi: SQP with damped BFGS Hessian blocks and a filter line search.
+
+    Runs without HSL: CasADi's blockSQP defaults to qpOASES' Schur-complement QP, which needs the HSL
+    `ma27` linear solver; we use the dense qpOASES QP (`schur` off, `linsol` "ldl"), which also means BFGS
+    instead of SR1 updates. It has no time limit (see the module docstring) and reports no iteration count:
+    we count its gradient-and-Jacobian evaluations, one per SQP iteration. Extra keyword options go to
+    blocksqp verbatim."""
+
+    name = plugin = "blocksqp"
+
+    def __init__(self, max_iterations: int = 500, max_wall_time: float = 60.0, tol: float = 1e-6,
+                 **blocksqp_options) -> None:
+        super().__init__(max_iterations, max_wall_time)
+        self.options = {"linsol": "ldl", "schur": False, "hess_update": 2, "max_iter": max_iterations,
+                        "opttol": tol, "nlinfeastol": tol, "print_header": False, "print_iteration": False,
+                        "print_maxit_reached": False, **blocksqp_options}
+
+    def plugin_options(self, nlp: NLP) -> dict:
+        return self.options
+
+    def iterations(self, stats: dict) -> int:
+        return int(stats.get("n_call_nlp_gf_jg", 0))
+
+
+class Fatrop(CasadiNlpsol):
+    """fatrop (structure-exploiting interior point) with exact Hessian, given our NLP as a single stage.
+
+    fatrop wants a stage-wise OCP (x_{k+1} = f(x_k, u_k) with stage-local constraints). The pseudospectral
+    NLP has no such structure: the differentiation matrix couples every knot with every other, and the
+    time variable enters every stage (its automatic structure detection rejects our NLP). So it gets one
+    stage (N = 0) whose "controls" are all of w and whose stage constraints are all of g; its Riccati
+    recursion then is one dense factorization per iteration. It needs the exact Hessian: on an NLP without
+    one it fails (status `failed`). Extra keyword options go to fatrop verbatim."""
+
+    name = plugin = "fatrop"
+    statuses = {"0": SolverStatus.CONVERGED}
+
+    def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, tol: float = 1e-6,
+                 **fatrop_options) -> None:
+        super().__init__(max_iterations, max_wall_time)
+        self.options = {"print_level": 0, "max_iter": max_iterations, "tol": tol, **fatrop_options}
+
+    def plugin_options(self, nlp: NLP) -> dict:
+        equality = [bool(e) for e in np.asarray(nlp.lbg) == np.asarray(nlp.ubg)]
+        return {"structure_detection": "manual", "N": 0, "nx": [0], "nu": [nlp.x.numel()],
+                "ng": [nlp.g.numel()], "equality": equality, "fatrop": self.options}

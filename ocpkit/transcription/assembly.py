@@ -90,9 +90,10 @@ class Assembly:
     def nlp_fields(self, x: ca.SX, f: ca.SX, own_parameters: ca.SX, shape_key: tuple) -> dict:
         """The NLP's fields: x, f, p = [μ, margin, limit_scale, collision parameters, own_parameters], g."""
         collision = ca.vertcat(*[c.parameters for c in self.constraints])
-        return dict(x=x, p=ca.vertcat(self.mu, self.margin_symbol, self.limit_scale, collision, own_parameters),
-                    f=f, g=ca.vertcat(*self.g), lbg=np.concatenate(self.lbg), ubg=np.concatenate(self.ubg),
-                    shape_key=shape_key)
+        fields = dict(x=x, p=ca.vertcat(self.mu, self.margin_symbol, self.limit_scale, collision, own_parameters),
+                      f=f, g=ca.vertcat(*self.g), lbg=np.concatenate(self.lbg), ubg=np.concatenate(self.ubg),
+                      shape_key=shape_key)
+        return self.dynamics.lift(fields)
 
     # -- numbers for one problem ---------------------------------------------------------------------
     def parameter_values(self, problem: Problem, refinement: Refinement, own: np.ndarray) -> np.ndarray:

@@ -44,6 +44,7 @@ class NLP(ABC):
     lbg: np.ndarray
     ubg: np.ndarray
     shape_key: tuple
+    exact_hessian: bool = True  # False: a dynamics backend (e.g. a callback) gives no second derivatives
 
     @abstractmethod
     def bounds(self, problem: Problem, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,190 @@
+"""Solvers from scipy.optimize.minimize fed with the NLP's CasADi functions: `scipy-slsqp` (SLSQP, dense
+quasi-Newton SQP) and `scipy-trust-constr` (trust-region interior point / equality SQP with sparse
+constraint Jacobian and the exact Lagrangian Hessian, BFGS updates on an NLP without second derivatives).
+
+Variables fixed by their bounds (lbx == ubx: boundary conditions) are taken out of the problem that SciPy
+sees (trust-constr turns bounds into barrier constraints and cannot handle empty intervals); the others
+form z (n_z,) = w[free]. Constraints lbg ≤ g ≤ ubg split into equalities (lbg == ubg) and the finite
+sides of the rest.
+
+Limits: `max_iterations` is SciPy's `maxiter`; the time limit is checked by the per-iteration callback,
+which raises StopIteration once `max_wall_time` (s) has passed (SciPy then ends with status 99 for SLSQP,
+3 for trust-constr), so it is honoured to within one iteration.
+"""
+
+from __future__ import annotations
+
+import time
+from abc import abstractmethod
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+import scipy.optimize as so
+
+from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
+from ocpkit.transcription.base import NLP
+
+
+@dataclass(frozen=True)
+class _Functions:
+    """CasADi functions of (w, p) for one NLP shape: f, ∇f (n_w,), g (n_g,), ∂g/∂w (n_g × n_w, sparse) and,
+    when built with Hessians, ∇²f and ∇²(vᵀg) (n_w × n_w) for constraint multipliers v (n_g,)."""
+
+    f: ca.Function
+    grad_f: ca.Function
+    g: ca.Function
+    jac_g: ca.Function
+    hess_f: ca.Function | None
+    hess_vg: ca.Function | None
+
+    @classmethod
+    def build(cls, nlp: NLP, hessians: bool) -> _Functions:
+        x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
+        v = ca.SX.sym("v", g.numel())
+        return cls(ca.Function("f", [x, p], [f]), ca.Function("grad_f", [x, p], [ca.gradient(f, x)]),
+                   ca.Function("g", [x, p], [g]), ca.Function("jac_g", [x, p], [ca.jacobian(g, x)]),
+                   ca.Function("hess_f", [x, p], [ca.hessian(f, x)[0]]) if hessians else None,
+                   ca.Function("hess_vg", [x, p, v], [ca.hessian(ca.dot(v, g), x)[0]]) if hessians else None)
+
+
+class _Reduced:
+    """The NLP in the free variables z for one query: w = w_fixed with w[free] = z; p fixed."""
+
+    def __init__(self, functions: _Functions, params: np.ndarray, lbx: np.ndarray, ubx: np.ndarray) -> None:
+        self.fn, self.params = functions, params
+        self.free = lbx < ubx
+        self.w = np.where(self.free, 0.0, lbx)
+
+    def full(self, z: np.ndarray) -> np.ndarray:
+        """w (n_w,) from z (n_z,)."""
+        w = self.w.copy()
+        w[self.free] = z
+        return w
+
+    def f(self, z: np.ndarray) -> float:
+        return float(self.fn.f(self.full(z), self.params))
+
+    def grad_f(self, z: np.ndarray) -> np.ndarray:
+        return np.asarray(self.fn.grad_f(self.full(z), self.params)).ravel()[self.free]
+
+    def g(self, z: np.ndarray) -> np.ndarray:
+        return np.asarray(self.fn.g(self.full(z), self.params)).ravel()
+
+    def jac_g(self, z: np.ndarray):
+        """∂g/∂z as a scipy.sparse CSC matrix (n_g × n_z)."""
+        return self.fn.jac_g(self.full(z), self.params).sparse()[:, self.free]
+
+    def objective_hessian(self):
+        """minimize's `hess`: z ↦ ∇²f (scipy.sparse, n_z × n_z), or BFGS updates when there is no exact one."""
+        if self.fn.hess_f is None:
+            return so.BFGS()
+        return lambda z: self.fn.hess_f(self.full(z), self.params).sparse()[self.free][:, self.free]
+
+    def constraint_hessian(self):
+        """NonlinearConstraint's `hess`: (z, v) ↦ ∇²(vᵀg) (scipy.sparse, n_z × n_z), or BFGS updates."""
+        if self.fn.hess_vg is None:
+            return so.BFGS()
+        return lambda z, v: self.fn.hess_vg(self.full(z), self.params, v).sparse()[self.free][:, self.free]
+
+
+class _Clock:
+    """minimize callback: raises StopIteration after `limit` s from construction."""
+
+    def __init__(self, limit: float) -> None:
+        self.deadline = time.perf_counter() + limit
+
+    def __call__(self, *args) -> None:
+        if time.perf_counter() > self.deadline:
+            raise StopIteration
+
+
+class ScipyMinimize(Solver):
+    """scipy.optimize.minimize with one method; subclasses give the method, how constraints are passed
+    and the meaning of SciPy's status codes. `max_wall_time` is in seconds; `options` go to minimize's
+    `options` verbatim."""
+
+    method: str
+    hessians = False
+    statuses: dict[int, SolverStatus]
+
+    def __init__(self, max_iterations: int = 500, max_wall_time: float = 60.0, **options) -> None:
+        self.max_iterations, self.max_wall_time = max_iterations, max_wall_time
+        self.options = {"maxiter": max_iterations, **options}
+        self._prepared: dict[tuple, _Functions] = {}
+
+    def prepare(self, nlp: NLP) -> None:
+        if nlp.shape_key not in self._prepared:
+            self._prepared[nlp.shape_key] = _Functions.build(nlp, self.hessians and nlp.exact_hessian)
+
+    @abstractmethod
+    def constraints(self, nlp: NLP, reduced: _Reduced) -> list:
+        """The constraints lbg ≤ g ≤ ubg in the form this method takes."""
+
+    def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
+              bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+        self.prepare(nlp)
+        lbx, ubx = (np.asarray(b, dtype=float) for b in bounds)
+        reduced = _Reduced(self._prepared[nlp.shape_key], np.asarray(params, dtype=float), lbx, ubx)
+        free = reduced.free
+        z0 = np.clip(np.asarray(guess, dtype=float), lbx, ubx)[free]
+        start = time.perf_counter()
+        try:
+            result = so.minimize(reduced.f, z0, method=self.method, jac=reduced.grad_f,
+                                 hess=reduced.objective_hessian() if self.hessians else None,
+                                 bounds=so.Bounds(lbx[free], ubx[free]),
+                                 constraints=self.constraints(nlp, reduced), options=self.options,
+                                 callback=_Clock(self.max_wall_time))
+        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # failed evaluation or factorization
+            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
+                                time.perf_counter() - start, f"{type(exc).__name__}: {exc}")
+        wall = time.perf_counter() - start
+        status = self.statuses.get(int(result.status), SolverStatus.FAILED)
+        return SolverResult(reduced.full(result.x), status, int(getattr(result, "nit", 0)), wall,
+                            str(result.message), {"status": int(result.status), "nfev": result.nfev})
+
+
+class ScipySlsqp(ScipyMinimize):
+    """SciPy's SLSQP (Kraft): dense BFGS SQP; equalities and the finite sides of the inequalities as dense
+    constraint blocks. `ftol` (objective change) is its stopping tolerance."""
+
+    name, method = "scipy-slsqp", "SLSQP"
+    statuses = {0: SolverStatus.CONVERGED, 4: SolverStatus.INFEASIBLE, 9: SolverStatus.ITERATION_LIMIT,
+                99: SolverStatus.TIME_LIMIT}
+
+    def __init__(self, max_iterations: int = 500, max_wall_time: float = 60.0, ftol: float = 1e-9,
+                 **options) -> None:
+        super().__init__(max_iterations, max_wall_time, ftol=ftol, **options)
+
+    def constraints(self, nlp: NLP, reduced: _Reduced) -> list:
+        lbg, ubg = np.asarray(nlp.lbg, dtype=float), np.asarray(nlp.ubg, dtype=float)
+        eq = lbg == ubg
+        lower, upper = ~eq & np.isfinite(lbg), ~eq & np.isfinite(ubg)
+        # g ≥ lbg and ubg ≥ g as c(z) ≥ 0, stacked; their Jacobian rows with the matching signs
+        sign = np.concatenate([np.ones(lower.sum()), -np.ones(upper.sum())])
+        offset = np.concatenate([lbg[lower], ubg[upper]])
+        rows = np.concatenate([np.flatnonzero(lower), np.flatnonzero(upper)])
+        blocks = [{"type": "eq", "fun": lambda z: reduced.g(z)[eq] - lbg[eq],
+                   "jac": lambda z: reduced.jac_g(z)[eq].toarray()},
+                  {"type": "ineq", "fun": lambda z: sign * (reduced.g(z)[rows] - offset),
+                   "jac": lambda z: sign[:, None] * reduced.jac_g(z)[rows].toarray()}]
+        return [block for block, size in zip(blocks, (eq.sum(), len(rows))) if size]
+
+
+class ScipyTrustConstr(ScipyMinimize):
+    """SciPy's trust-constr: trust-region interior point with the sparse constraint Jacobian and the exact
+    Hessians of f and of vᵀg (CasADi AD). `gtol`/`xtol` are its tolerances (on the Lagrangian gradient and
+    the trust radius); ending on either counts as converged, as SciPy itself reports it."""
+
+    name, method = "scipy-trust-constr", "trust-constr"
+    hessians = True
+    statuses = {0: SolverStatus.ITERATION_LIMIT, 1: SolverStatus.CONVERGED, 2: SolverStatus.CONVERGED,
+                3: SolverStatus.TIME_LIMIT}
+
+    def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, gtol: float = 1e-6,
+                 xtol: float = 1e-10, **options) -> None:
+        super().__init__(max_iterations, max_wall_time, gtol=gtol, xtol=xtol, **options)
+
+    def constraints(self, nlp: NLP, reduced: _Reduced) -> list:
+        return [so.NonlinearConstraint(reduced.g, nlp.lbg, nlp.ubg, jac=reduced.jac_g,
+                                       hess=reduced.constraint_hessian())]
