@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import numpy as np
 
@@ -97,8 +98,9 @@ def plan(problem: Problem, planner: str = "simultaneous", **options: Any) -> Pla
     return PLANNERS.get(planner)(problem, **options)
 
 
-def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str = "casadi-rnea",
-                      solver: str = "ipopt", guess: str | np.ndarray = "line", refinements: int = 5,
+def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
+                      dynamics: str = "casadi-rnea", solver: str = "ipopt", guess: str | np.ndarray = "line",
+                      refinements: int = 5,
                       transcription_options: dict | None = None, solver_options: dict | None = None) -> Plan:
     """Path and timing together as one optimal control problem (the paper's method).
 
@@ -121,9 +123,10 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
         if verification.ok or result.status != SolverStatus.CONVERGED or rounds >= refinements or not len(fresh):
             break
         excess = verification.limit_excess
+        shrink = 1.0 - excess - 0.005 if excess > 0 else 1.0
         refinement = Refinement(np.concatenate([fresh, refinement.check_fractions]),  # newest take the slots
                                 refinement.extra_margin + _margin_step(verification.penetration),
-                                refinement.limit_scale * (1.0 - excess - 0.005) if excess > 0 else refinement.limit_scale)
+                                refinement.limit_scale * shrink)
         w, rounds = result.w, rounds + 1
     if result.status != SolverStatus.CONVERGED:
         status = result.status.value

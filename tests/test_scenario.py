@@ -33,7 +33,8 @@ def test_paper_cases_load_in_radians(case1):
 
 
 def test_unit_rad_is_taken_as_is(case1):
-    case1["unit"], case1["start"], case1["goal"] = "rad", np.radians(case1["start"]).tolist(), np.radians(case1["goal"]).tolist()
+    case1["unit"] = "rad"
+    case1["start"], case1["goal"] = np.radians(case1["start"]).tolist(), np.radians(case1["goal"]).tolist()
     np.testing.assert_allclose(load(case1).start, load_scenario(CASE1).start)
 
 
@@ -93,7 +94,8 @@ def test_start_exactly_at_a_limit_is_accepted(case1):
 
 def test_goal_in_obstacle_names_the_sphere(case1):
     case1["scene"]["obstacles"][0]["sphere"]["center"] = [0.4, 1.09, 0.6]  # at the place position
-    with pytest.raises(ScenarioError, match=r"goal configuration is in collision: sphere \d+ \(link_\d\) overlaps obstacle 0"):
+    message = r"goal configuration is in collision: sphere \d+ \(link_\d\) overlaps obstacle 0"
+    with pytest.raises(ScenarioError, match=message):
         load(case1)
 
 

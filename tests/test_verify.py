@@ -22,7 +22,9 @@ def quintic(problem, tf: float, tau_offset: float = 0.0) -> Trajectory:
 
     def at(t: np.ndarray) -> Samples:
         x = np.clip(np.asarray(t) / tf, 0, 1)[:, None]
-        s, ds, dds = 10 * x**3 - 15 * x**4 + 6 * x**5, (30 * x**2 - 60 * x**3 + 30 * x**4) / tf, (60 * x - 180 * x**2 + 120 * x**3) / tf**2
+        s = 10 * x**3 - 15 * x**4 + 6 * x**5
+        ds = (30 * x**2 - 60 * x**3 + 30 * x**4) / tf
+        dds = (60 * x - 180 * x**2 + 120 * x**3) / tf**2
         q, qd, qdd = problem.start + s * delta, ds * delta, dds * delta
         tau = np.array([pin.rnea(robot.model, data, *row).copy() for row in zip(q, qd, qdd)]) + robot.friction(qd)
         return Samples(np.asarray(t), q, qd, qdd, tau + tau_offset, np.gradient(tau, np.asarray(t), axis=0))

@@ -51,7 +51,8 @@ STUDY_OPTIONS = {"refinements": 0, "solver_options": {"tol": 1e-9}}
 COLUMNS = ("variant", "transcription", "knots", "points", "status", "tf", "tf_ref", "tf_error",
            "dynamics_residual", "solve_time_s", "setup_time_s", "iterations")
 ERROR_FLOOR = 1e-12  # plotted in place of an error of exactly 0
-STYLE = {"chebyshev": ("tab:blue", "o"), "chebyshev×3": ("tab:purple", "D"), "hermite-simpson": ("tab:green", "s"), "trapezoidal": ("tab:red", "^")}
+STYLE = {"chebyshev": ("tab:blue", "o"), "chebyshev×3": ("tab:purple", "D"), "hermite-simpson": ("tab:green", "s"),
+         "trapezoidal": ("tab:red", "^")}
 
 
 @dataclass(frozen=True)

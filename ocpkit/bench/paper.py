@@ -128,7 +128,8 @@ def _paper_table(problems: list[Problem], measured: dict, label: str, counts: tu
                  f"[{p.velocity_lower_bound():.2f}]" for k, p in enumerate(problems)]
         lines.append(_row("motion time t_f", knots, cells))
     for knots in counts:
-        cells = [f"{measured[p.name, knots].solve_time:.3f} {_paper(PAPER_SOLVE, knots, k)}" for k, p in enumerate(problems)]
+        cells = [f"{measured[p.name, knots].solve_time:.3f} {_paper(PAPER_SOLVE, knots, k)}"
+                 for k, p in enumerate(problems)]
         lines.append(_row("computation time", knots, cells))
     for knots in counts:
         lines.append(_row("status", knots, [measured[p.name, knots].plan.status for p in problems]))

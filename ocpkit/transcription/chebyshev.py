@@ -8,7 +8,8 @@ follows the steep Coulomb term (tanh) where a joint reverses; a polynomial throu
 (we measured 2 % of the torque range of dynamic inconsistency from that alone). With the differentiation
 matrix D (on s ∈ [-1, 1]) and Clenshaw–Curtis weights w:
 
-    dynamics     D X = (t_f/2) F(X, U):  D Q = (t_f/2) Qd,  D Qd = (t_f/2) Qdd,  residual(q_i, qd_i, qdd_i, tau_max u_i) = 0
+    dynamics     D X = (t_f/2) F(X, U):  D Q = (t_f/2) Qd,  D Qd = (t_f/2) Qdd,
+                 residual(q_i, qd_i, qdd_i, tau_max u_i) = 0
     torque rate  tau'(t) = (2/t_f) (tau_max D U + friction'(qd) (t_f/2) Qdd), bounded as |dtau/ds| ≤ (t_f/2) taud_max
     jerk         q'''(T_i) = (2/t_f) (D Qdd)_i
     cost         t_f + μ Σ_i (t_f/2) w_i q'''_iᵀ Q q'''_i  =  t_f + μ (2/t_f) Σ_i w_i (D Qdd)_iᵀ Q (D Qdd)_i

@@ -11,7 +11,8 @@ s_0 = 1 > … > s_N = −1 like the Chebyshev knots. On them:
 The NLP (dynamics D X = (t_f/2) F, jerk, cost with these weights, checks, segments) is pseudospectral.py's.
 Compared with Chebyshev's Clenshaw–Curtis weights (exact to degree N) the LGL quadrature of the jerk cost is
 exact to degree 2N − 1, which covers the squared jerk of the degree-N interpolant. References: Canuto et al.,
-*Spectral Methods* (2006), §2.2; Fahroo & Ross, *Costate estimation by a Legendre pseudospectral method*, JGCD 24 (2001).
+*Spectral Methods* (2006), §2.2; Fahroo & Ross, *Costate estimation by a Legendre pseudospectral method*,
+JGCD 24 (2001).
 """
 
 from __future__ import annotations

@@ -26,7 +26,8 @@ from __future__ import annotations
 
 from abc import abstractmethod
 
-from typing import Any, Callable, NamedTuple
+from typing import Any, NamedTuple
+from collections.abc import Callable
 
 import casadi as ca
 import numpy as np

@@ -9,7 +9,7 @@ Berrut & Trefethen, *Barycentric Lagrange Interpolation*, SIAM Review 46 (2004).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
