@@ -1,4 +1,6 @@
-"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper`, `ocpkit list`. User mistakes print one line, exit 2."""
+"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper|convergence|solvers`, `ocpkit list`.
+
+User mistakes print one line and exit with 2."""
 
 from __future__ import annotations
 
@@ -7,7 +9,7 @@ import dataclasses
 import sys
 from pathlib import Path
 
-from ocpkit.errors import OcpkitError
+from ocpkit.errors import OcpkitError, OptionError
 
 
 def _plan_command(args: argparse.Namespace) -> int:
@@ -41,9 +43,20 @@ def _bench_command(args: argparse.Namespace) -> int:
 
         run_convergence(Path(args.out or "results/convergence"), case=Path(args.case or DEFAULT_CASE))
         return 0
+    if args.suite == "solvers":
+        from ocpkit.bench.solvers import run_solver_benchmark
+
+        if args.knots and len(args.knots) != 1:
+            raise OptionError(f"bench solvers runs one knot count, got --knots {' '.join(map(str, args.knots))}")
+        run_solver_benchmark(Path(args.scenarios), Path(args.out or "results/solvers"),
+                             solvers=tuple(args.solvers) if args.solvers else None,
+                             dynamics=tuple(args.dynamics) if args.dynamics else None,
+                             knots=args.knots[0] if args.knots else 12, repeats=args.repeats or 1,
+                             max_wall_time=args.max_wall_time)
+        return 0
     from ocpkit.bench.paper import KNOTS, run_paper_benchmark
 
-    run_paper_benchmark(Path(args.scenarios), Path(args.out or "results/paper"), repeats=args.repeats,
+    run_paper_benchmark(Path(args.scenarios), Path(args.out or "results/paper"), repeats=args.repeats or 5,
                         hard=Path(args.hard) if args.hard else None, transcription=args.transcription,
                         knots=tuple(args.knots) if args.knots else KNOTS,
                         transcription_options={"segments": args.segments} if args.segments else None)
@@ -73,24 +86,31 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--transcription", default="chebyshev")
     p.add_argument("--knots", type=int, default=12, help="number of knot intervals N (default 12)")
     p.add_argument("--segments", type=int, help="pseudospectral segments K (chebyshev, lgl; default 1)")
-    p.add_argument("--dynamics", default="casadi-rnea", help="casadi-rnea (default, inverse form) or casadi (ABA)")
-    p.add_argument("--solver", default="ipopt")
+    p.add_argument("--dynamics", default="casadi-rnea", help="dynamics backend (default casadi-rnea; see "
+                   "`ocpkit list`)")
+    p.add_argument("--solver", default="ipopt", help="NLP solver (default ipopt; see `ocpkit list`)")
     p.add_argument("--mu", type=float, default=None, help="jerk weight μ (default: the scenario's)")
     p.add_argument("-o", "--output", help="write the trajectory JSON here")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite")
-    b.add_argument("suite", choices=["paper", "convergence"],
-                   help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription")
+    b.add_argument("suite", choices=["paper", "convergence", "solvers"],
+                   help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
+                   "solvers: every NLP solver x dynamics backend on the paper cases")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
                    "('' to skip it)")
     b.add_argument("--out", default=None, help="output folder (default results/SUITE): results.csv and "
                    "trajectories/, or convergence.csv and convergence.png")
     b.add_argument("--case", default=None, help="convergence: the scenario file (default scenarios/paper/case2.yaml)")
-    b.add_argument("--repeats", type=int, default=5, help="solves per plan; the median is reported")
+    b.add_argument("--repeats", type=int, default=None, help="solves per plan; the median is reported "
+                   "(default 5 for paper, 1 for solvers)")
     b.add_argument("--transcription", default="chebyshev", help="paper: the simultaneous planner's transcription")
-    b.add_argument("--knots", type=int, nargs="+", help="paper: knot counts N (default 12 8)")
+    b.add_argument("--knots", type=int, nargs="+", help="paper: knot counts N (default 12 8); solvers: one N "
+                   "(default 12)")
     b.add_argument("--segments", type=int, help="paper: pseudospectral segments K (chebyshev, lgl)")
+    b.add_argument("--solvers", nargs="+", help="solvers: the solvers to run (default: all registered)")
+    b.add_argument("--dynamics", nargs="+", help="solvers: the dynamics backends to run (default: all registered)")
+    b.add_argument("--max-wall-time", type=float, default=30.0, help="solvers: time limit per NLP solve, s")
     b.set_defaults(run=_bench_command)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, solvers, "
                              "planners, guesses) with one line each")

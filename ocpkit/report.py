@@ -16,10 +16,14 @@ def trajectory_header(problem: Problem, plan: Plan) -> dict:
 
 
 def result_row(suite: str, case: str, plan: Plan, solve_time: float, setup_time: float) -> dict:
-    """One results.csv row; max_violation is the largest excess of any checked quantity over its limit
-    (relative for limits and dynamics, metres for sphere contact, rad for boundary errors), 0 if none."""
-    excess = max([0.0] + [c.worst for c in plan.verification.checks])
+    """One results.csv row (max_violation: see `max_violation`)."""
     return {"suite": suite, "case": case, **{k: plan.method.get(k, "") for k in
             ("planner", "transcription", "knots", "solver", "dynamics")}, "status": plan.status,
             "tf": f"{plan.trajectory.tf:.4f}", "solve_time_s": f"{solve_time:.4f}", "setup_time_s": f"{setup_time:.3f}",
-            "iterations": plan.stats.iterations, "max_violation": f"{excess:.3g}"}
+            "iterations": plan.stats.iterations, "max_violation": f"{max_violation(plan):.3g}"}
+
+
+def max_violation(plan: Plan) -> float:
+    """The largest excess of any checked quantity over its limit (relative for limits and dynamics, metres for
+    sphere contact, rad for boundary errors), 0 if none."""
+    return max([0.0] + [c.worst for c in plan.verification.checks])

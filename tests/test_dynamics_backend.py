@@ -22,7 +22,7 @@ def numeric(expr_fn, *args) -> np.ndarray:
     return np.asarray(ca.Function("f", symbols, [expr_fn(*symbols)])(*args)).squeeze()
 
 
-@pytest.mark.parametrize("name", ["casadi", "casadi-rnea"])
+@pytest.mark.parametrize("name", DYNAMICS.names())
 def test_inverse_and_forward_include_friction(name):
     dynamics = make_dynamics(name, ROBOT)
     data = ROBOT.model.createData()
@@ -32,7 +32,7 @@ def test_inverse_and_forward_include_friction(name):
         np.testing.assert_allclose(numeric(dynamics.forward, q, qd, tau), qdd, atol=1e-8)
 
 
-@pytest.mark.parametrize("name", ["casadi", "casadi-rnea"])
+@pytest.mark.parametrize("name", ["casadi", "casadi-rnea"])  # the callback backends: test_dynamics_pinocchio
 def test_residual_vanishes_exactly_on_consistent_states(name):
     dynamics = make_dynamics(name, ROBOT)
     data = ROBOT.model.createData()

@@ -1,5 +1,6 @@
-"""The `pinocchio` dynamics backend: its RNEA callback (values, analytic Jacobian) against pinocchio, finite
-differences and `casadi-rnea`; the SX → MX lift of an NLP; and a plan against casadi-rnea."""
+"""The pinocchio callback backends: `pinocchio` (ABA, computeABADerivatives) and `pinocchio-rnea` (RNEA,
+computeRNEADerivatives). Their callbacks (values, analytic Jacobian) against pinocchio, finite differences and
+our symbolic SX algorithms; the SX → MX lift of an NLP against the symbolic twin backend."""
 
 from __future__ import annotations
 
@@ -10,46 +11,51 @@ import pytest
 
 from ocpkit import load_robot
 from ocpkit.dynamics import make_dynamics
-from ocpkit.transcription.base import NLP
 
 ROBOT = load_robot("industrial6")
 N = ROBOT.n
 RNG = np.random.default_rng(5)
 STATES = [(RNG.uniform(ROBOT.q_lower, ROBOT.q_upper), RNG.uniform(-2, 2, N), RNG.uniform(-5, 5, N))
           for _ in range(10)]
-COLUMNS = np.stack([np.concatenate(state) for state in STATES], axis=1)  # (3n, K)
+COLUMNS = np.stack([np.concatenate(state) for state in STATES], axis=1)  # (3n, K): [q; v; a] per point
+TWIN = {"pinocchio": "casadi", "pinocchio-rnea": "casadi-rnea"}
+"""Each callback backend and the symbolic backend with the same defect form."""
+PINOCCHIO = {"pinocchio": pin.aba, "pinocchio-rnea": pin.rnea}
 
 
-def _symbolic_rnea(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """casadi-rnea's RNEA and its AD Jacobian at the columns, in the callback's layout."""
-    symbolic = make_dynamics("casadi-rnea", ROBOT).symbolic
+def _symbolic(name: str, columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The twin's SX algorithm (ABA or RNEA) and its AD Jacobian at the columns, in the callback's layout."""
+    symbolic = make_dynamics(TWIN[name], ROBOT).symbolic
+    algorithm = symbolic.forward_dynamics if name == "pinocchio" else symbolic.inverse_dynamics
     X = ca.SX.sym("X", 3 * N, columns.shape[1])
-    tau = ca.horzcat(*[symbolic.inverse_dynamics(X[:N, k], X[N:2 * N, k], X[2 * N:, k]) for k in range(X.size2())])
-    value, jac = ca.Function("rnea", [X], [tau, ca.jacobian(tau, X)])(columns)
+    y = ca.horzcat(*[algorithm(X[:N, k], X[N:2 * N, k], X[2 * N:, k]) for k in range(X.size2())])
+    value, jac = ca.Function("y", [X], [y, ca.jacobian(y, X)])(columns)
     return np.asarray(value), np.asarray(ca.densify(jac))
 
 
-def _callback_rnea(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _callback(name: str, columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The callback's value and the CasADi Jacobian of its call on MX symbols."""
-    callback = make_dynamics("pinocchio", ROBOT).callback(columns.shape[1])
+    callback = make_dynamics(name, ROBOT).callback(columns.shape[1])
     X = ca.MX.sym("X", 3 * N, columns.shape[1])
-    value, jac = ca.Function("rnea", [X], [callback(X), ca.jacobian(callback(X), X)])(columns)
+    value, jac = ca.Function("y", [X], [callback(X), ca.jacobian(callback(X), X)])(columns)
     return np.asarray(value), np.asarray(ca.densify(jac))
 
 
-def test_callback_values_match_pinocchio_and_casadi_rnea():
-    value, _ = _callback_rnea(COLUMNS)
+@pytest.mark.parametrize("name", TWIN)
+def test_callback_values_match_pinocchio_and_the_symbolic_algorithm(name):
+    value, _ = _callback(name, COLUMNS)
     data = ROBOT.model.createData()
-    expected = np.stack([pin.rnea(ROBOT.model, data, q, qd, qdd) for q, qd, qdd in STATES], axis=1)
+    expected = np.stack([PINOCCHIO[name](ROBOT.model, data, *state) for state in STATES], axis=1)
     np.testing.assert_allclose(value, expected, atol=1e-8, rtol=0)
-    np.testing.assert_allclose(value, _symbolic_rnea(COLUMNS)[0], atol=1e-8, rtol=0)
+    np.testing.assert_allclose(value, _symbolic(name, COLUMNS)[0], atol=1e-8, rtol=0)
 
 
-def test_callback_jacobian_matches_casadi_rnea_and_finite_differences():
-    _, jac = _callback_rnea(COLUMNS)
-    symbolic = _symbolic_rnea(COLUMNS)[1]
-    np.testing.assert_allclose(jac, symbolic, atol=1e-6, rtol=0)
-    callback = make_dynamics("pinocchio", ROBOT).callback(COLUMNS.shape[1])
+@pytest.mark.parametrize("name", TWIN)
+def test_callback_jacobian_matches_symbolic_ad_and_finite_differences(name):
+    _, jac = _callback(name, COLUMNS)
+    scale = max(1.0, np.abs(jac).max())
+    np.testing.assert_allclose(jac, _symbolic(name, COLUMNS)[1], atol=1e-8 * scale, rtol=0)
+    callback = make_dynamics(name, ROBOT).callback(COLUMNS.shape[1])
     flat, step = COLUMNS.ravel(order="F"), 1e-6
     fd = np.empty_like(jac)
     for c in range(flat.size):
@@ -57,14 +63,15 @@ def test_callback_jacobian_matches_casadi_rnea_and_finite_differences():
         e[c] = step
         plus, minus = (np.asarray(callback((flat + s * e).reshape(COLUMNS.shape, order="F"))) for s in (1, -1))
         fd[:, c] = ((plus - minus) / (2 * step)).ravel(order="F")
-    np.testing.assert_allclose(jac, fd, atol=1e-6 * max(1.0, np.abs(jac).max()), rtol=0)
-    # block diagonal: a point's torque depends on its own state only
+    np.testing.assert_allclose(jac, fd, atol=1e-6 * scale, rtol=0)
+    # block diagonal: a point's value depends on its own state only
     assert callback.jacobian_sparsity.nnz() == COLUMNS.shape[1] * N * 3 * N
 
 
+@pytest.mark.parametrize("name", TWIN)
 @pytest.mark.parametrize("kind", ["numbers", "MX"])
-def test_residual_vanishes_exactly_on_consistent_states(kind):
-    dynamics = make_dynamics("pinocchio", ROBOT)
+def test_residual_vanishes_exactly_on_consistent_states(name, kind):
+    dynamics = make_dynamics(name, ROBOT)
     data = ROBOT.model.createData()
     for q, qd, qdd in STATES[:3]:
         rigid = pin.rnea(ROBOT.model, data, q, qd, qdd).copy()
@@ -77,39 +84,24 @@ def test_residual_vanishes_exactly_on_consistent_states(kind):
             assert (np.abs(r).max() < 1e-8) == vanishes
 
 
-def test_lift_turns_an_sx_nlp_with_placeholders_into_the_same_mx_nlp():
+@pytest.mark.parametrize("name", TWIN)
+def test_lift_turns_an_sx_nlp_with_placeholders_into_the_same_mx_nlp(name):
     """The SX residual records placeholders; `lift` gives an MX NLP whose f, g and Jacobian equal those of the
-    same NLP built with casadi-rnea's symbolic residual."""
+    same NLP built with the twin's symbolic residual."""
     x, p = ca.SX.sym("x", 4 * N * 2), ca.SX.sym("p", 1)
     fields = {}
-    for name in ("casadi-rnea", "pinocchio"):
-        dynamics = make_dynamics(name, ROBOT)
+    for backend in (TWIN[name], name):
+        dynamics = make_dynamics(backend, ROBOT)
         cols = [x[4 * N * k:4 * N * (k + 1)] for k in range(2)]
         g = ca.vertcat(*[dynamics.residual(c[:N], c[N:2 * N], c[2 * N:3 * N], p * c[3 * N:]) for c in cols])
         f = ca.sumsqr(g) + p * ca.sumsqr(x)
-        fields[name] = dict(x=x, p=p, f=f, g=g, lbg=None, ubg=None, shape_key=())
-        if name == "pinocchio":
-            fields[name] = dynamics.lift(fields[name])
-            assert isinstance(fields[name]["x"], ca.MX) and fields[name]["exact_hessian"] is False
+        fields[backend] = dynamics.lift(dict(x=x, p=p, f=f, g=g, lbg=None, ubg=None, shape_key=()))
+    lifted = fields[name]
+    assert isinstance(lifted["x"], ca.MX) and lifted["exact_hessian"] is False
     x0 = np.concatenate([COLUMNS[:, 0], RNG.uniform(-1, 1, N), COLUMNS[:, 1], RNG.uniform(-1, 1, N)])
     out = {}
-    for name, fl in fields.items():
+    for backend, fl in fields.items():
         fn = ca.Function("nlp", [fl["x"], fl["p"]], [fl["f"], fl["g"], ca.jacobian(fl["g"], fl["x"])])
-        out[name] = [np.asarray(ca.densify(v)) for v in fn(x0, 30.0)]
-    for a, b in zip(out["casadi-rnea"], out["pinocchio"]):
+        out[backend] = [np.asarray(ca.densify(v)) for v in fn(x0, 30.0)]
+    for a, b in zip(out[TWIN[name]], out[name]):
         np.testing.assert_allclose(b, a, atol=1e-8 * max(1.0, np.abs(a).max()), rtol=0)
-
-
-_HOOKED = "exact_hessian" in getattr(NLP, "__dataclass_fields__", {})
-
-
-@pytest.mark.slow
-@pytest.mark.skipif(not _HOOKED, reason="needs the NLP.exact_hessian / Assembly.nlp_fields lift hook")
-def test_plan_case2_matches_casadi_rnea():
-    import ocpkit
-
-    problem = ocpkit.load_scenario("scenarios/paper/case2.yaml")
-    reference = ocpkit.plan(problem, knots=8, dynamics="casadi-rnea")
-    plan = ocpkit.plan(problem, knots=8, dynamics="pinocchio")
-    assert reference.ok and plan.ok, (reference.status, plan.status)
-    assert abs(plan.trajectory.tf - reference.trajectory.tf) <= 0.01 * reference.trajectory.tf

@@ -11,12 +11,11 @@ import pytest
 from helpers import REPO
 
 import ocpkit
-from ocpkit.solvers.base import SolverStatus
-from ocpkit.solvers.casadi_nlpsol import BlockSqp, Fatrop, Ipopt, SqpMethod
-from ocpkit.solvers.scipy_minimize import ScipySlsqp, ScipyTrustConstr
+from ocpkit.errors import OptionError
+from ocpkit.solvers.base import SOLVERS, SolverStatus
 from ocpkit.transcription.base import NLP
 
-ALL_SOLVERS = {cls.name: cls for cls in (Ipopt, SqpMethod, BlockSqp, Fatrop, ScipySlsqp, ScipyTrustConstr)}
+ALL_SOLVERS = {name: SOLVERS.get(name) for name in SOLVERS.names()}
 
 
 @dataclass
@@ -80,7 +79,7 @@ def test_iteration_limit_is_reported(name):
     assert result.status == SolverStatus.ITERATION_LIMIT, result.message
 
 
-@pytest.mark.parametrize("name", ["ipopt", "sqpmethod", "scipy-slsqp", "scipy-trust-constr"])
+@pytest.mark.parametrize("name", ["ipopt", "sqpmethod", "scipy-slsqp", "scipy-trust-constr", "pyomo", "scp"])
 def test_time_limit_is_reported(name):  # blocksqp and fatrop cannot be interrupted
     nlp = rosenbrock_disk()
     result = ALL_SOLVERS[name](max_wall_time=1e-9).solve(nlp, nlp.initial_guess(), nlp.parameters(), nlp.bounds())
@@ -94,7 +93,16 @@ def test_casadi_errors_become_a_failed_status(name):
     assert result.status == SolverStatus.FAILED and "x0" in result.message
 
 
-VERIFIES = {"ipopt", "sqpmethod"}
+@pytest.mark.parametrize("name, options, exact_hessian, words", [
+    ("fatrop", {}, False, "exact Hessian"),  # a callback backend's NLP
+    ("sqpmethod", {"qpsol": "hpipm"}, True, "cannot be set up"),  # hpipm wants stage structure
+])
+def test_a_solver_that_cannot_take_the_nlp_says_so_at_set_up(name, options, exact_hessian, words):
+    with pytest.raises(OptionError, match=words):
+        ALL_SOLVERS[name](**options).prepare(rosenbrock_disk(exact_hessian))
+
+
+VERIFIES = {"ipopt", "sqpmethod", "pyomo", "scp"}
 """Solvers that reliably verify case 2 at 8 knots; the others must end in a reported status."""
 
 

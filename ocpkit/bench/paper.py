@@ -53,7 +53,7 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
     tables; write results.csv and trajectories/. With `hard` (a folder of scenarios), also compare the
     straight-line and the OMPL initial guess on the paper cases and those. The simultaneous planner uses
     `transcription` (with `transcription_options`); the single-knot-count comparisons use knots[0]."""
-    problems = _load_all(Path(scenarios))
+    problems = load_all(Path(scenarios))
     method = {"transcription": transcription, "transcription_options": transcription_options or {}}
     rows, simultaneous, baseline = [], {}, {}
     for form in dynamics:
@@ -80,12 +80,12 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
     print(_baseline_table(problems, {c: m for (c, k), m in first.items() if k == knots[0]}, baseline, matched))
     if hard is not None:
         seeding = {(p.name, guess): measure(p, 1, knots=knots[0], dynamics=dynamics[0], guess=guess, **method)
-                   for p in problems + _load_all(Path(hard)) for guess in ("line", "ompl")}
+                   for p in problems + load_all(Path(hard)) for guess in ("line", "ompl")}
         rows += [result_row(f"seeding-{guess}", name, m.plan, m.solve_time, m.setup_time)
                  for (name, guess), m in seeding.items()]
         print(_seeding_table(seeding))
     write_csv(out / "results.csv", rows)
-    print(f"machine: {_cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
+    print(f"machine: {cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
           f"computation times are medians of {repeats} runs per plan (seeding: 1 run)")
     return rows
 
@@ -98,7 +98,8 @@ def _matched_to_baseline(problems: list[Problem]) -> list[Problem]:
     return [dataclasses.replace(p, robot=robots[id(p.robot)], mu=1e-3) for p in problems]
 
 
-def _load_all(folder: Path) -> list[Problem]:
+def load_all(folder: Path) -> list[Problem]:
+    """Every scenario (*.yaml) in `folder`, sorted by file name; ScenarioError if there is none."""
     files = sorted(folder.glob("*.yaml"))
     if not files:
         raise ScenarioError(f"no scenario files (*.yaml) in {folder}")
@@ -199,7 +200,8 @@ def _row(label: str, knots: int, cells: list[str]) -> str:
     return f"{label:<20}{knots:>6}" + "".join(f"{c:>{WIDTH}}" for c in cells)
 
 
-def _cpu_name() -> str:
+def cpu_name() -> str:
+    """The CPU model name (for the machine line under a benchmark table)."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):

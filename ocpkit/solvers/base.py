@@ -32,7 +32,9 @@ class SolverStatus(str, Enum):
 
 @dataclass(frozen=True)
 class SolverResult:
-    """Solution w (n_w,), status, iteration count, wall time (s), solver message and raw stats."""
+    """Solution w (n_w,), status, iteration count, wall time (s), solver message, raw stats, and the
+    multipliers where the solver reports them: lam_g (n_g,) of lbg ≤ g ≤ ubg and lam_x (n_w,) of the bounds,
+    in CasADi's sign convention (positive on an active upper bound, negative on an active lower one)."""
 
     w: np.ndarray
     status: SolverStatus
@@ -40,6 +42,8 @@ class SolverResult:
     wall_time: float
     message: str
     stats: dict = field(default_factory=dict, repr=False)
+    lam_g: np.ndarray | None = field(default=None, repr=False)
+    lam_x: np.ndarray | None = field(default=None, repr=False)
 
 
 class Solver(ABC):

@@ -14,12 +14,16 @@ overran `max_wall_time` is reported as `time_limit` after the fact.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
 import time
 from abc import abstractmethod
 
 import casadi as ca
 import numpy as np
 
+from ocpkit.errors import OptionError
 from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
 from ocpkit.transcription.base import NLP
 
@@ -30,9 +34,30 @@ _UNIFIED_STATUS = {
 }
 
 
-def _hessian(nlp: NLP) -> str:
+def hessian_approximation(nlp: NLP) -> str:
     """The `hessian_approximation` option for this NLP: "exact" unless its derivatives stop at first order."""
     return "exact" if nlp.exact_hessian else "limited-memory"
+
+
+@contextlib.contextmanager
+def _silenced_stdout():
+    """Send the process's standard output (file descriptor 1) to /dev/null: qpOASES prints its licence banner
+    from C++ whenever a QP solver is created (sqpmethod: at set-up; blocksqp: every solve), options or not."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as devnull:
+            os.dup2(devnull.fileno(), 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _last_line(exc: Exception) -> str:
+    """The innermost message of a CasADi error (its last line, without the source location)."""
+    line = str(exc).strip().splitlines()[-1]
+    return line.split(" failed: ", 1)[-1] if "Assertion" in line else line
 
 
 class _Deadline(ca.Callback):
@@ -88,7 +113,12 @@ class CasadiNlpsol(Solver):
             deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel()) if self.stops_by_callback else None
             if deadline is not None:
                 options["iteration_callback"] = deadline
-            self._prepared[nlp.shape_key] = (ca.nlpsol(self.name, self.plugin, problem, options), deadline)
+            try:
+                with _silenced_stdout():
+                    solver = ca.nlpsol(self.name, self.plugin, problem, options)
+            except RuntimeError as exc:  # an option or structure the plugin rejects: the caller's choice
+                raise OptionError(f"{self.name} cannot be set up for this NLP: {_last_line(exc)}") from exc
+            self._prepared[nlp.shape_key] = (solver, deadline)
 
     def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
               bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
@@ -98,7 +128,8 @@ class CasadiNlpsol(Solver):
         if deadline is not None:
             deadline.deadline = start + self.max_wall_time
         try:
-            out = solver(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=nlp.lbg, ubg=nlp.ubg)
+            with _silenced_stdout():
+                out = solver(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=nlp.lbg, ubg=nlp.ubg)
             stats = solver.stats()
         except RuntimeError as exc:  # a plugin's assertion or failed evaluation: a status, not a crash
             return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
@@ -106,7 +137,8 @@ class CasadiNlpsol(Solver):
         wall = time.perf_counter() - start
         message = str(stats.get("return_status", stats.get("unified_return_status", "unknown")))
         return SolverResult(np.asarray(out["x"]).ravel(), self._status(stats, message, wall),
-                            self.iterations(stats), wall, message, stats)
+                            self.iterations(stats), wall, message, stats,
+                            np.asarray(out["lam_g"]).ravel(), np.asarray(out["lam_x"]).ravel())
 
     def iterations(self, stats: dict) -> int:
         """Iterations the plugin took, from its stats."""
@@ -146,7 +178,7 @@ class Ipopt(CasadiNlpsol):
                         **ipopt_options}
 
     def plugin_options(self, nlp: NLP) -> dict:
-        return {"ipopt": {"hessian_approximation": _hessian(nlp), **self.options}}
+        return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}}
 
 
 _QPSOL_QUIET = {"qpoases": {"printLevel": "none"}, "osqp": {"osqp": {"verbose": False}}}
@@ -156,11 +188,13 @@ _QPSOL_QUIET = {"qpoases": {"printLevel": "none"}, "osqp": {"osqp": {"verbose": 
 class SqpMethod(CasadiNlpsol):
     """CasADi's SQP (`sqpmethod`) with exact Hessian (L-BFGS when the NLP has none) and line search.
 
-    `qpsol` names the QP solver: qpoases (dense active set, the default: it converges on small, tight
-    NLPs where osqp's ADMM accuracy does not), osqp (sparse ADMM: about 10x faster on the paper cases at
-    12 knots), proxqp, hpipm. `convexify_strategy` ("regularize", "eigen-clip",
-    "eigen-reflect") convexifies the Lagrangian Hessian: off (None) by default, as the paper cases converge
-    without it and "regularize" stalls case 2 at the iteration limit. The time limit is checked between SQP
+    `qpsol` names the QP solver: qpoases (dense active set, the default: it handles the indefinite
+    Hessians of nonconvex NLPs, where osqp's convex ADMM diverges), osqp (sparse ADMM: about 10x faster
+    on the paper cases at 12 knots, where it converges), proxqp (hits the time limit on the paper cases),
+    hpipm (needs a stage-wise OCP structure that our NLPs lack: refused with an OptionError).
+    `convexify_strategy` ("regularize", "eigen-clip", "eigen-reflect") convexifies the Lagrangian Hessian:
+    off (None) by default, as the paper cases converge without it, "regularize" stalls case 2 at the
+    iteration limit and "eigen-clip" with osqp fails in the first QP. The time limit is checked between SQP
     iterations, so one long QP (qpoases' first, cold-started) can overrun it. Extra keyword options go to
     sqpmethod verbatim."""
 
@@ -183,7 +217,7 @@ class SqpMethod(CasadiNlpsol):
             self.options["convexify_strategy"] = convexify_strategy
 
     def plugin_options(self, nlp: NLP) -> dict:
-        return {"hessian_approximation": _hessian(nlp), **self.options}
+        return {"hessian_approximation": hessian_approximation(nlp), **self.options}
 
 
 class BlockSqp(CasadiNlpsol):
@@ -218,8 +252,8 @@ class Fatrop(CasadiNlpsol):
     NLP has no such structure: the differentiation matrix couples every knot with every other, and the
     time variable enters every stage (its automatic structure detection rejects our NLP). So it gets one
     stage (N = 0) whose "controls" are all of w and whose stage constraints are all of g; its Riccati
-    recursion then is one dense factorization per iteration. It needs the exact Hessian: on an NLP without
-    one it fails (status `failed`). Extra keyword options go to fatrop verbatim."""
+    recursion then is one dense factorization per iteration. It needs the exact Hessian: an NLP without one
+    (a callback dynamics backend) is refused with an OptionError. Extra keyword options go to fatrop verbatim."""
 
     name = plugin = "fatrop"
     statuses = {"0": SolverStatus.CONVERGED}
@@ -230,6 +264,9 @@ class Fatrop(CasadiNlpsol):
         self.options = {"print_level": 0, "max_iter": max_iterations, "tol": tol, **fatrop_options}
 
     def plugin_options(self, nlp: NLP) -> dict:
+        if not nlp.exact_hessian:
+            raise OptionError("fatrop needs the exact Hessian, and this NLP's dynamics backend gives first "
+                              "derivatives only; use a symbolic backend (casadi, casadi-rnea) or another solver")
         equality = [bool(e) for e in np.asarray(nlp.lbg) == np.asarray(nlp.ubg)]
         return {"structure_detection": "manual", "N": 0, "nx": [0], "nu": [nlp.x.numel()],
                 "ng": [nlp.g.numel()], "equality": equality, "fatrop": self.options}

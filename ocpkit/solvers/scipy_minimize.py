@@ -16,42 +16,19 @@ from __future__ import annotations
 
 import time
 from abc import abstractmethod
-from dataclasses import dataclass
 
-import casadi as ca
 import numpy as np
 import scipy.optimize as so
 
 from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
+from ocpkit.solvers.nlp_functions import NLPFunctions
 from ocpkit.transcription.base import NLP
-
-
-@dataclass(frozen=True)
-class _Functions:
-    """CasADi functions of (w, p) for one NLP shape: f, ∇f (n_w,), g (n_g,), ∂g/∂w (n_g × n_w, sparse) and,
-    when built with Hessians, ∇²f and ∇²(vᵀg) (n_w × n_w) for constraint multipliers v (n_g,)."""
-
-    f: ca.Function
-    grad_f: ca.Function
-    g: ca.Function
-    jac_g: ca.Function
-    hess_f: ca.Function | None
-    hess_vg: ca.Function | None
-
-    @classmethod
-    def build(cls, nlp: NLP, hessians: bool) -> _Functions:
-        x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
-        v = ca.SX.sym("v", g.numel())
-        return cls(ca.Function("f", [x, p], [f]), ca.Function("grad_f", [x, p], [ca.gradient(f, x)]),
-                   ca.Function("g", [x, p], [g]), ca.Function("jac_g", [x, p], [ca.jacobian(g, x)]),
-                   ca.Function("hess_f", [x, p], [ca.hessian(f, x)[0]]) if hessians else None,
-                   ca.Function("hess_vg", [x, p, v], [ca.hessian(ca.dot(v, g), x)[0]]) if hessians else None)
 
 
 class _Reduced:
     """The NLP in the free variables z for one query: w = w_fixed with w[free] = z; p fixed."""
 
-    def __init__(self, functions: _Functions, params: np.ndarray, lbx: np.ndarray, ubx: np.ndarray) -> None:
+    def __init__(self, functions: NLPFunctions, params: np.ndarray, lbx: np.ndarray, ubx: np.ndarray) -> None:
         self.fn, self.params = functions, params
         self.free = lbx < ubx
         self.w = np.where(self.free, 0.0, lbx)
@@ -111,11 +88,12 @@ class ScipyMinimize(Solver):
     def __init__(self, max_iterations: int = 500, max_wall_time: float = 60.0, **options) -> None:
         self.max_iterations, self.max_wall_time = max_iterations, max_wall_time
         self.options = {"maxiter": max_iterations, **options}
-        self._prepared: dict[tuple, _Functions] = {}
+        self._prepared: dict[tuple, NLPFunctions] = {}
 
     def prepare(self, nlp: NLP) -> None:
         if nlp.shape_key not in self._prepared:
-            self._prepared[nlp.shape_key] = _Functions.build(nlp, self.hessians and nlp.exact_hessian)
+            exact = self.hessians and nlp.exact_hessian
+            self._prepared[nlp.shape_key] = NLPFunctions.build(nlp, exact, exact)
 
     @abstractmethod
     def constraints(self, nlp: NLP, reduced: _Reduced) -> list:
