@@ -225,7 +225,9 @@ class BlockSqp(CasadiNlpsol):
 
     Runs without HSL: CasADi's blockSQP defaults to qpOASES' Schur-complement QP, which needs the HSL
     `ma27` linear solver; we use the dense qpOASES QP (`schur` off, `linsol` "ldl"), which also means BFGS
-    instead of SR1 updates. It has no time limit (see the module docstring) and reports no iteration count:
+    instead of SR1 updates. It cannot take an NLP without second derivatives (a callback dynamics backend):
+    CasADi's blocksqp differentiates the constraint Jacobian at set-up even for BFGS (an OptionError from
+    `prepare`). It has no time limit (see the module docstring) and reports no iteration count:
     we count its gradient-and-Jacobian evaluations, one per SQP iteration. Extra keyword options go to
     blocksqp verbatim."""
 

@@ -20,7 +20,9 @@ constraints cost it about 1.2 s per Hessian (45 s per solve). So a shared node w
 Expressions. Lifting all shared nodes (~3600) makes ripopt's KKT solves the bottleneck (0.6 s/iteration);
 measured on case 2, lift_above = 300 (~260 lifted) gave the fastest solves (6 s, ~28 iterations, against
 10 to 45 s for 30, 100, 1000, 10⁴ and no lifting). The lifted problem has the same solutions and the same
-multipliers of g.
+multipliers of g. A lifted node that depends on fixed variables only (e.g. the dynamics at a rest knot) is
+fixed at its value for the query: left free, its defining equality has one free variable, and ripopt then
+ended "optimal" with that equality violated by up to 7.5 (seen with the `casadi` backend on case 1).
 
 Status, from ripopt's message (the .sol file's, which follows IPOPT's wording): `_STATUSES`, anything else
 is `failed` (then the starting point is returned: Pyomo does not load a solution with an error status), as
@@ -168,6 +170,7 @@ class _PyomoNlp:
                               "NLP; use a CasADi solver such as ipopt instead")
         lifted, named = dag.shared_nodes(lift_above)
         self.lifted_values = ca.Function("lifted", [nlp.x, nlp.p], [fn.instructions_sx()[lifted]])
+        self.lifted_inputs = ca.DM(self.lifted_values.sparsity_jac(0, 0), 1.0).sparse()  # (n_lifted, n_w) pattern
         m = self.model = pyo.ConcreteModel()
         m.w = pyo.Var(range(nlp.x.numel()))
         m.p = pyo.Param(range(nlp.p.numel()), mutable=True, initialize=0.0)
@@ -229,8 +232,11 @@ class _PyomoNlp:
                 var.setlb(lower)
                 var.setub(upper)
                 var.set_value(float(value), skip_validation=True)
-        for var, value in zip(m.lifted.values(), np.asarray(self.lifted_values(start, params)).ravel()):
+        values = np.asarray(self.lifted_values(start, params)).ravel()
+        determined = self.lifted_inputs @ (lbx != ubx).astype(float) == 0  # depends on fixed w only
+        for var, value, fixed in zip(m.lifted.values(), values, determined):
             var.set_value(float(value), skip_validation=True)
+            var.fixed = bool(fixed)
 
     def solution(self) -> tuple[np.ndarray, np.ndarray]:
         """(w (n_w,), lam_g (n_g,)) as loaded into the model."""
