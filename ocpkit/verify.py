@@ -10,6 +10,10 @@ within the stated tolerance:
                                              clearance);  tolerance 0 (no contact allowed)
   boundary    |q − q_start/goal|, |qd|, |qdd| at t = 0 and t_f (rad, rad/s, rad/s²);  tolerance 1e-6
 
+A trajectory whose t_f is not finite or lies outside the problem's time bounds by more than 1 % (a solver's
+diverged iterate can have t_f ~ 1e11 s) fails the single check `motion_time` (relative excess) instead and is
+not sampled.
+
 The torque limit is checked on the inverse-dynamics torque, i.e. the torque the motion really needs.
 """
 
@@ -28,6 +32,7 @@ LIMIT_TOLERANCE = 0.01
 DYNAMICS_TOLERANCE = 0.01
 GEOMETRY_TOLERANCE = 0.0
 BOUNDARY_TOLERANCE = 1e-6
+TIME_TOLERANCE = 0.01
 GEOMETRY_CHECKS = ("self_collision", "obstacle", "workspace")
 SCALED_LIMITS = ("velocity", "torque", "torque_rate")
 
@@ -79,6 +84,9 @@ class Verification:
 
 def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verification:
     """Re-check `trajectory` against every constraint of `problem` on a dense grid of step dt (s)."""
+    outside = _motion_time_outside_bounds(problem, trajectory.tf)
+    if outside is not None:
+        return Verification((outside,), np.zeros(0))
     samples = trajectory.sample(dt)
     robot = problem.robot
     tau_needed = _inverse_dynamics(problem, samples)
@@ -98,6 +106,15 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
     path_violation = np.max([_per_time(v) - LIMIT_TOLERANCE for v in excess.values()]
                             + [_per_time(v) for v in penetration.values()], axis=0)
     return Verification(tuple(checks), _peak_times(samples.t, path_violation))
+
+
+def _motion_time_outside_bounds(problem: Problem, tf: float) -> Check | None:
+    """The failed `motion_time` check if t_f (s) is not finite or outside the time bounds beyond tolerance."""
+    bounds = problem.time
+    excess = max(tf / bounds.max - 1.0, 1.0 - tf / bounds.min) if np.isfinite(tf) else np.inf
+    if excess <= TIME_TOLERANCE:
+        return None
+    return Check("motion_time", float(excess), TIME_TOLERANCE, float(tf) if np.isfinite(tf) else 0.0, "rel")
 
 
 def _inverse_dynamics(problem: Problem, samples: Samples) -> np.ndarray:

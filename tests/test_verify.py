@@ -68,3 +68,9 @@ def test_torque_that_does_not_match_the_motion_fails_dynamics():
 def test_wrong_goal_fails_boundary():
     moved = dataclasses.replace(PROBLEM, goal=PROBLEM.goal + 0.01)
     assert not by_name(verify(moved, quintic(PROBLEM, 4.0)))["boundary"].ok
+
+
+@pytest.mark.parametrize("tf", [3e11, np.inf, 0.05])
+def test_motion_time_outside_the_time_bounds_fails_without_sampling(tf):
+    verification = verify(PROBLEM, quintic(PROBLEM, tf))  # 3e11 s at 1 ms would be 2 PiB of samples
+    assert [c.name for c in verification.checks] == ["motion_time"] and not verification.ok
