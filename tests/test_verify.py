@@ -70,7 +70,7 @@ def test_wrong_goal_fails_boundary():
     assert not by_name(verify(moved, quintic(PROBLEM, 4.0)))["boundary"].ok
 
 
-@pytest.mark.parametrize("tf", [3e11, np.inf, 0.05])
+@pytest.mark.parametrize("tf", [3e11, 0.05])
 def test_motion_time_outside_the_time_bounds_fails_without_sampling(tf):
     verification = verify(PROBLEM, quintic(PROBLEM, tf))  # 3e11 s at 1 ms would be 2 PiB of samples
     assert [c.name for c in verification.checks] == ["motion_time"] and not verification.ok
