@@ -1,6 +1,6 @@
 """ocpkit: robot motion planning as an optimal control problem (path and timing together).
 
-Public API: load_scenario, load_robot, Problem, plan, Trajectory, verify.
+Public API: load_scenario, load_robot, Problem, plan, build, Trajectory, verify.
 """
 
 import os
@@ -9,7 +9,9 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from ocpkit.planner import Plan, plan  # noqa: E402
+from ocpkit.build_cache import Build, build  # noqa: E402
+from ocpkit.plan import Plan  # noqa: E402
+from ocpkit.planner import plan  # noqa: E402
 from ocpkit.problem import Problem, TimeBounds  # noqa: E402
 from ocpkit.robots import Robot, load_robot  # noqa: E402
 from ocpkit.scenario import load_scenario  # noqa: E402
@@ -17,5 +19,5 @@ from ocpkit.scene import Scene, Workspace  # noqa: E402
 from ocpkit.trajectory import Trajectory, write_json  # noqa: E402
 from ocpkit.verify import Verification, verify  # noqa: E402
 
-__all__ = ["Plan", "Problem", "Robot", "Scene", "TimeBounds", "Trajectory", "Verification", "Workspace",
-           "load_robot", "load_scenario", "plan", "verify", "write_json"]
+__all__ = ["Build", "Plan", "Problem", "Robot", "Scene", "TimeBounds", "Trajectory", "Verification", "Workspace",
+           "build", "load_robot", "load_scenario", "plan", "verify", "write_json"]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ocpkit.planner import Plan
+from ocpkit.plan import Plan
 from ocpkit.problem import Problem
 
 RESULT_COLUMNS = ("suite", "case", "planner", "transcription", "knots", "solver", "dynamics", "status", "tf",

@@ -9,13 +9,12 @@ import numpy as np
 import yaml
 
 from ocpkit.errors import OcpkitError, ScenarioError
-from ocpkit.geometry import collision_report
 from ocpkit.problem import Problem, TimeBounds
 from ocpkit.robots import load_robot
 from ocpkit.scene import Scene, Workspace
+from ocpkit.validation import validate
 
 _KEYS = {"robot", "unit", "start", "goal", "scene", "time", "cost", "name"}
-LIMIT_SLACK = 1e-9  # rad: a start or goal exactly at a limit, given in degrees, must not fail on round-off
 
 
 def load_scenario(path: str | Path) -> Problem:
@@ -58,24 +57,6 @@ def problem_from_dict(data: Any, base_dir: Path | None = None, name: str = "prob
     problem = Problem(robot, start, goal, scene, time, mu, str(data.get("name", name)))
     validate(problem)
     return problem
-
-
-def validate(problem: Problem) -> None:
-    """Raise ScenarioError if start or goal is outside the joint limits or in collision, or t_f is impossible."""
-    robot = problem.robot
-    for label, q in (("start", problem.start), ("goal", problem.goal)):
-        outside = (q < robot.q_lower - LIMIT_SLACK) | (q > robot.q_upper + LIMIT_SLACK)
-        for i in np.nonzero(outside)[0]:
-            raise ScenarioError(
-                f"{label}: joint {i + 1} ({robot.joint_names[i]}) = {np.degrees(q[i]):.2f} deg is outside "
-                f"[{np.degrees(robot.q_lower[i]):.2f}, {np.degrees(robot.q_upper[i]):.2f}] deg")
-        contacts = collision_report(robot, problem.scene, q)
-        if contacts:
-            raise ScenarioError(f"{label} configuration is in collision: " + "; ".join(contacts))
-    lower_bound = problem.velocity_lower_bound()
-    if problem.time.max < lower_bound:
-        raise ScenarioError(f"time.max = {problem.time.max} s is below the velocity-limited minimum "
-                            f"{lower_bound:.3f} s (max_i |goal_i - start_i| / qd_max_i)")
 
 
 def _mapping(value: Any, where: str) -> dict:

@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 
 from ocpkit import load_scenario, plan  # noqa: E402
 from ocpkit.bench.convergence import plot_convergence, read_rows, run_convergence  # noqa: E402
-from ocpkit.planner import prepared  # noqa: E402
+from ocpkit.build_cache import build  # noqa: E402
 from ocpkit.geometry import clearances, sphere_centers  # noqa: E402
 from ocpkit.transcription.polynomials import differentiation_matrix, lobatto_points  # noqa: E402
 
@@ -71,12 +71,10 @@ def between_knots(path: Path, knots: int = 8) -> dict:
     """case1 at `knots` with margin 0 and no refinement: obstacle clearance of the interpolant vs time, whole
     motion (left) and around its minimum (right), with the knots and the check times between them marked."""
     problem = load_scenario(ROOT / "scenarios" / "paper" / "case1.yaml")
-    options = {"knots": knots, "margin": 0.0}
     result = plan(problem, knots=knots, refinements=0, transcription_options={"margin": 0.0})
     traj, robot = result.trajectory, problem.robot
-    nlp, _, _ = prepared(problem, "chebyshev", "casadi-rnea", "ipopt", options, {})
-    fixed = getattr(nlp, "check_sigma", getattr(nlp, "check_s", np.zeros(0)))  # s ∈ [-1, 1] of the fixed checks
-    s_checks = np.concatenate([fixed, nlp.adaptive_default])
+    d = build(problem, knots=knots, transcription_options={"margin": 0.0}).discretization
+    s_checks = np.concatenate([d.check_sigma, d.adaptive_default])  # σ ∈ [-1, 1] of the fixed and adaptive checks
     clear = lambda q: clearances(robot, problem.scene, sphere_centers(robot, q)).obstacles  # noqa: E731
     smallest = lambda q: 100 * clear(q).reshape(len(q), -1).min(axis=1)  # noqa: E731  cm
     dense = traj.sample(1e-3)

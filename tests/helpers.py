@@ -5,7 +5,16 @@ from __future__ import annotations
 import importlib.metadata
 from pathlib import Path
 
+import numpy as np
 import pytest
+from numpy.polynomial import Polynomial
+
+from ocpkit.constraints import make_constraints
+from ocpkit.dynamics import make_dynamics
+from ocpkit.problem import Problem
+from ocpkit.robots import rigid_torque
+from ocpkit.trajectory import Samples, Trajectory
+from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE_ROBOTS = {
@@ -25,3 +34,30 @@ def example_robot_urdf(name: str) -> Path:
         if file.as_posix().endswith(suffix):
             return Path(dist.locate_file(file))
     pytest.fail(f"{suffix} is not part of the installed example-robot-data")
+
+
+def discretize(problem: Problem, transcription: str, dynamics: str = "casadi", **options) -> Discretization:
+    """The Discretization of `problem` by the named transcription (with `options`), dynamics backend and the
+    default constraints, without a solver."""
+    method = TRANSCRIPTIONS.get(transcription)(**options)
+    return method.build(problem, make_dynamics(dynamics, problem.robot), make_constraints(problem))
+
+
+def polynomial_motion(problem: Problem, tf: float, shape: Polynomial) -> Trajectory:
+    """q(t) = start + shape(t / tf) (goal − start), with its exact inverse-dynamics torque."""
+    robot, delta = problem.robot, problem.goal - problem.start
+    derivatives = [shape.deriv(k) for k in range(4)]
+
+    def at(t: np.ndarray) -> Samples:
+        x = np.asarray(t, dtype=float) / tf
+        q, qd, qdd, jerk = (np.outer(p(x) / tf**k, delta) for k, p in enumerate(derivatives))
+        q += problem.start
+        tau = rigid_torque(robot, q, qd, qdd) + robot.friction(qd)
+        return Samples(np.asarray(t, dtype=float), q, qd, qdd, tau, np.zeros_like(tau))
+
+    return Trajectory(at(np.array([0.0, tf])), at)
+
+
+def monomial(degree: int) -> Polynomial:
+    """s ↦ s^degree."""
+    return Polynomial([0.0] * degree + [1.0])

@@ -1,137 +1,124 @@
-"""End-to-end planning: the paper cases verify, shapes are reused, failures are reported as statuses, and
-the exported JSON passes an outside check that knows nothing of ocpkit."""
+"""`finish` (status and stats of a Plan) and `ocpkit.plan` (validation before any planner, option errors)."""
 
 from __future__ import annotations
 
-import csv
 import dataclasses
-import json
-import shutil
-import subprocess
-import sys
+import importlib
+import types
 
+import numpy as np
 import pytest
-from helpers import REPO
+from helpers import REPO, monomial, polynomial_motion
 
 import ocpkit
-from ocpkit.bench.paper import run_paper_benchmark
-from ocpkit.cli import main
-from ocpkit.report import RESULT_COLUMNS, trajectory_header
+from ocpkit.errors import OptionError, ScenarioError
+from ocpkit.geometry import sphere_centers
+from ocpkit.plan import finish
+from ocpkit.planner import PLANNERS
+from ocpkit.scene import Scene
+from ocpkit.verify import Check, Verification
 
-CASES = sorted((REPO / "scenarios/paper").glob("case*.yaml"))
-DATA = REPO / "ocpkit/robots/data/industrial6"
-pytestmark = pytest.mark.slow
-
-
-@pytest.mark.parametrize("knots", [12, 8])
-@pytest.mark.parametrize("case", CASES, ids=lambda p: p.stem)
-def test_paper_case_is_verified(case, knots):
-    problem = ocpkit.load_scenario(case)
-    result = ocpkit.plan(problem, knots=knots)
-    assert result.status == "verified", result.verification.summary()
-    assert problem.velocity_lower_bound() < result.trajectory.tf < 3.0
+PLAN = importlib.import_module("ocpkit.plan")  # the module: `ocpkit.plan` is the function
+CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
+FREE = dataclasses.replace(CASE2, scene=Scene(workspace=CASE2.scene.workspace))
+PASSED = Verification((Check("torque", -0.5, 0.01, 0.1, "rel"),), np.zeros(0))
+FAILED = Verification((Check("torque", 0.5, 0.01, 0.1, "rel"),), np.array([0.1]))
+MINIMUM_JERK = 10 * monomial(3) - 15 * monomial(4) + 6 * monomial(5)
 
 
-def test_second_query_of_a_shape_reuses_the_build():
-    problem = ocpkit.load_scenario(CASES[1])
-    ocpkit.plan(problem, knots=8)
-    moved = dataclasses.replace(problem, scene=dataclasses.replace(
-        problem.scene, obstacle_centers=problem.scene.obstacle_centers + [0.0, 0.05, 0.0]))
-    again = ocpkit.plan(moved, knots=8)
-    assert again.stats.setup_time == 0.0
-    assert again.ok, again.verification.summary()
+@pytest.fixture
+def motion():
+    return polynomial_motion(FREE, 4.0, MINIMUM_JERK)
 
 
-def test_iteration_limit_is_a_status_not_a_success():
-    problem = ocpkit.load_scenario(CASES[0])
-    result = ocpkit.plan(problem, knots=8, solver_options={"max_iterations": 3})
+@pytest.fixture
+def clock(monkeypatch):
+    """ocpkit.plan's clock, frozen at 10 s."""
+    monkeypatch.setattr(PLAN, "time", types.SimpleNamespace(perf_counter=lambda: 10.0))
+
+
+@pytest.mark.parametrize("given, status", [(PASSED, "verified"), (FAILED, "violated")])
+def test_a_finished_plan_is_verified_or_violated_as_the_verification_says(motion, given, status):
+    result = finish(FREE, motion, None, {"planner": "test"}, 0.0, verification=given)
+    assert result.status == status and result.ok == (status == "verified")
+    assert result.verification is given and result.method == {"planner": "test"}
+
+
+@pytest.mark.parametrize("given", [PASSED, FAILED])
+def test_the_planners_word_is_the_status_when_it_stopped(motion, given):
+    result = finish(FREE, motion, "iteration_limit", {}, 0.0, verification=given)
     assert result.status == "iteration_limit" and not result.ok
 
 
-def test_time_bound_below_what_the_torques_allow_is_not_verified():
-    problem = ocpkit.load_scenario(CASES[0])
-    rushed = dataclasses.replace(problem, time=ocpkit.TimeBounds(0.1, problem.velocity_lower_bound() * 1.02, 0.5))
-    result = ocpkit.plan(rushed, knots=8)
-    assert result.status in ("infeasible", "failed", "violated") and not result.ok
+def test_finish_verifies_the_trajectory_when_no_verification_is_given(motion):
+    result = finish(FREE, motion, None, {}, 0.0)
+    assert result.status == "verified", result.verification.summary()
+    assert {c.name for c in result.verification.checks} >= {"torque", "obstacle", "boundary"}
+    moved = dataclasses.replace(FREE, goal=FREE.goal + 0.01)
+    assert finish(moved, motion, None, {}, 0.0).status == "violated"  # the motion misses the goal
 
 
-def test_exported_json_passes_the_outside_check(tmp_path):
-    problem = ocpkit.load_scenario(CASES[0])
-    result = ocpkit.plan(problem, knots=12)
-    path = tmp_path / "case1.json"
-    ocpkit.write_json(path, result.trajectory, trajectory_header(problem, result))
-    document = json.loads(path.read_text())
-    assert document["format"] == "ocpkit.trajectory/1" and document["status"] == "verified"
-    assert document["samples"]["t"][1] == pytest.approx(0.001)
-    assert document["samples"]["t"][-1] == pytest.approx(document["tf"])
-    check = subprocess.run([sys.executable, str(REPO / "tests/outside_check.py"), str(path), str(DATA / "spec.yaml"),
-                            str(DATA / "robot.urdf"), str(CASES[0])], capture_output=True, text=True)
-    assert check.returncode == 0, check.stdout + check.stderr
+def test_solve_time_excludes_the_setup_time(motion, clock):
+    result = finish(FREE, motion, None, {}, started=4.0, setup_time=1.5, iterations=12, rounds=2, message="ok",
+                    extra={"k": 1}, verification=PASSED)
+    stats = result.stats
+    assert stats.solve_time == pytest.approx(4.5) and stats.setup_time == 1.5
+    assert (stats.iterations, stats.rounds, stats.solver_message, stats.extra) == (12, 2, "ok", {"k": 1})
 
 
-def test_cli_plan_prints_status_and_writes_json(tmp_path, capsys):
-    out = tmp_path / "t.json"
-    assert main(["plan", str(CASES[2]), "--knots", "8", "-o", str(out)]) == 0
-    printed = capsys.readouterr().out
-    assert "status verified" in printed and "iterations" in printed and "checks: all pass" in printed
-    assert json.loads(out.read_text())["method"]["knots"] == 8
+def test_stats_extra_defaults_to_an_empty_dict(motion, clock):
+    assert finish(FREE, motion, None, {}, 10.0, verification=PASSED).stats.extra == {}
 
 
-def test_cli_reports_user_mistakes_in_one_line(tmp_path, capsys):
-    bad = tmp_path / "bad.yaml"
-    bad.write_text("robot: robby\nunit: deg\nstart: [0]\ngoal: [0]\n")
-    assert main(["plan", str(bad)]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("error: ") and "unknown robot 'robby'" in err and "Traceback" not in err
+@pytest.fixture
+def spy(monkeypatch):
+    """A registered planner `spy(problem, speed=1.0)` that records its calls."""
+    calls = []
+
+    def planner(problem, speed: float = 1.0):
+        calls.append((problem, speed))
+        return "planned"
+
+    monkeypatch.setitem(PLANNERS._items, "spy", planner)
+    return calls
 
 
-def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
-    shutil.copy(CASES[3], tmp_path / CASES[3].name)
-    run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1, dynamics=("casadi-rnea", "casadi"))
-    rows = list(csv.DictReader((tmp_path / "out/results.csv").open()))
-    assert tuple(rows[0]) == RESULT_COLUMNS
-    assert [(r["planner"], r["dynamics"], r["knots"], r["status"]) for r in rows[:4]] == [
-        ("simultaneous", "casadi-rnea", "12", "verified"), ("simultaneous", "casadi-rnea", "8", "verified"),
-        ("simultaneous", "casadi", "12", "verified"), ("simultaneous", "casadi", "8", "verified")]
-    assert rows[4]["planner"] == "ompl-toppra" and rows[4]["status"] in ("verified", "violated")
-    assert (tmp_path / "out/trajectories/case4-ompl-toppra-toppra-1000.json").exists()
-    assert (tmp_path / "out/trajectories/case4-simultaneous-chebyshev-12.json").exists()
-    printed = capsys.readouterr().out
-    assert "motion time t_f" in printed and "paper set-up" in printed and "ratio sim / baseline" in printed
+def test_a_valid_problem_reaches_the_planner_with_its_options(spy):
+    assert ocpkit.plan(CASE2, "spy", speed=2.0) == "planned"
+    assert spy == [(CASE2, 2.0)]
 
 
-def test_refinement_repairs_contact_between_check_times():
-    problem = ocpkit.load_scenario(CASES[1])
-    no_margin = {"margin": 0.0}
-    unrefined = ocpkit.plan(problem, knots=8, refinements=0, transcription_options=no_margin)
-    assert unrefined.status == "violated" and unrefined.verification.penetration > 0
-    refined = ocpkit.plan(problem, knots=8, transcription_options=no_margin)
-    assert refined.ok and refined.stats.rounds >= 1
-    assert refined.stats.setup_time == 0.0  # the same NLP, re-solved: refinement needs no rebuild
+def test_a_start_outside_the_limits_is_refused_naming_the_joint(spy):
+    start = CASE2.start.copy()
+    start[1] = CASE2.robot.q_upper[1] + 0.1
+    with pytest.raises(ScenarioError, match=r"start: joint 2 \(joint_2\)"):
+        ocpkit.plan(dataclasses.replace(CASE2, start=start), "spy")
+    assert spy == []
 
 
-def test_ompl_guess_seeds_the_simultaneous_planner():
-    problem = ocpkit.load_scenario(CASES[3])
-    seeded = ocpkit.plan(problem, knots=8, guess="ompl")
-    assert seeded.ok, seeded.verification.summary()
-    assert seeded.trajectory.tf == pytest.approx(ocpkit.plan(problem, knots=8).trajectory.tf, rel=0.02)
+def test_a_start_in_collision_is_refused(spy):
+    centre = sphere_centers(CASE2.robot, CASE2.start)[12]
+    blocked = dataclasses.replace(CASE2, scene=Scene(centre[None], np.array([0.05]), CASE2.scene.workspace))
+    with pytest.raises(ScenarioError, match="start configuration is in collision: .*sphere 12"):
+        ocpkit.plan(blocked, "spy")
+    assert spy == []
 
 
-def test_cli_runs_the_baseline_and_reports_what_it_violates(capsys):
-    code = main(["plan", str(CASES[2]), "--planner", "ompl-toppra"])
-    printed = capsys.readouterr().out
-    assert code == 1 and "status violated" in printed and "torque_rate" in printed
+def test_nan_in_the_goal_is_refused(spy):
+    goal = CASE2.goal.copy()
+    goal[3] = np.nan
+    with pytest.raises(ScenarioError, match="goal needs 6 finite joint values"):
+        ocpkit.plan(dataclasses.replace(CASE2, goal=goal), "spy")
+    assert spy == []
 
 
-def test_an_option_a_transcription_does_not_take_is_a_one_line_error(capsys):
-    assert main(["plan", str(CASES[1]), "--transcription", "trapezoidal", "--segments", "2"]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("error: trapezoidal: ") and "'segments'" in err
+def test_an_option_the_planner_does_not_take_lists_its_options(spy):
+    with pytest.raises(OptionError, match="bogus") as error:
+        ocpkit.plan(CASE2, "spy", bogus=1)
+    assert str(error.value).endswith("its options: speed") and spy == []
 
 
-def test_paper_benchmark_takes_another_transcription(tmp_path, capsys):
-    shutil.copy(CASES[1], tmp_path / CASES[1].name)
-    rows = run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1, dynamics=("casadi-rnea",),
-                               transcription="hermite-simpson", knots=(10,))
-    assert (rows[0]["transcription"], rows[0]["knots"], rows[0]["status"]) == ("hermite-simpson", 10, "verified")
-    assert "hermite-simpson + ipopt" in capsys.readouterr().out
+def test_an_option_the_simultaneous_planner_does_not_take_lists_its_options():
+    with pytest.raises(OptionError, match="'planner_name'") as error:
+        ocpkit.plan(CASE2, planner_name="rrtconnect")
+    assert all(option in str(error.value) for option in ("knots", "solver", "refinements", "constraints"))

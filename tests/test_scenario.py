@@ -9,6 +9,7 @@ import pytest
 import yaml
 from helpers import REPO
 
+import ocpkit
 from ocpkit import load_scenario
 from ocpkit.errors import RobotError, ScenarioError
 from ocpkit.scenario import problem_from_dict
@@ -140,3 +141,23 @@ def test_workspace_min_below_max(case1):
 def test_scenario_must_be_a_mapping():
     with pytest.raises(ScenarioError, match="must be a mapping"):
         problem_from_dict([1, 2, 3])
+
+
+def test_an_edited_robot_spec_is_read_again_by_the_next_scenario_load(case1, tmp_path):
+    robot_dir = REPO / "ocpkit/robots/data/industrial6"
+    (tmp_path / "robot.urdf").write_text((robot_dir / "robot.urdf").read_text())
+    spec = yaml.safe_load((robot_dir / "spec.yaml").read_text())
+    (tmp_path / "spec.yaml").write_text(yaml.safe_dump(spec))
+    case1["robot"] = {"urdf": "robot.urdf", "spec": "spec.yaml"}
+    (tmp_path / "case.yaml").write_text(yaml.safe_dump(case1))
+    before = load_scenario(tmp_path / "case.yaml")
+
+    spec["limits"]["velocity"][0] /= 2
+    (tmp_path / "spec.yaml").write_text(yaml.safe_dump(spec))
+    after = load_scenario(tmp_path / "case.yaml")
+
+    assert after.robot.qd_max[0] == pytest.approx(before.robot.qd_max[0] / 2)
+    assert after.robot.key != before.robot.key
+    discretization = ocpkit.build(after, knots=4).discretization  # a new build: the robot's content changed
+    upper = discretization.bounds(after)[1][discretization.nlp.variables.index("qd")[1:-1, 0]]  # inner knots
+    np.testing.assert_allclose(upper, after.robot.qd_max[0])

@@ -5,7 +5,7 @@ dense `verify`. Each step is one function below:
 
 1. `FreeSpace`: OMPL's validity test is the verifier's own collision model (`geometry.sphere_centers`,
    `geometry.clearances`: robot spheres against each other, the obstacle spheres and the workspace box):
-   a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 as in the Chebyshev transcription).
+   a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
    The joint limits are the state-space bounds.
 2. `_ompl_path`: RRTConnect (or RRT*, BIT*, PRM) in joint space. A straight segment is checked, batched, at
    configurations at most `resolution` rad apart (Euclidean over the joints). OMPL's PathSimplifier then
@@ -25,7 +25,7 @@ Choices and what they cost, stated plainly:
 - Constant s̈ between grid points (toppra's ParametrizeConstAccel, not its default spline refit). The motion
   stays exactly on the collision-checked path, and the limits hold where TOPP-RA imposed them. The default
   refits a spline in time through the grid points: it leaves the path between them and does not stop with
-  qdd = 0 (we measured 5 to 12 rad/s² at t_f on paper cases 1 and 2).
+  qdd = 0 (on the paper cases it ends far from rest, failing the boundary check).
 - Friction. TOPP-RA's constraints are linear in (s̈, ṡ²). The friction law viscous·qd + coulomb·tanh(qd/ε)
   depends on ṡ, so it enters as toppra's path-dependent term, evaluated at an assumed speed profile. The
   first pass assumes every moving joint is at its velocity limit (the largest friction). The second pass
@@ -39,7 +39,7 @@ Choices and what they cost, stated plainly:
   what a 1 kHz servo loop would have to follow. The baseline normally fails the torque-rate check; the plan
   says so in its status ("violated").
 
-OMPL and toppra are optional dependencies, imported on first use (toppra alone takes about 1 s to import).
+OMPL and toppra are optional dependencies, imported on first use (toppra is slow to import).
 """
 
 from __future__ import annotations
@@ -55,13 +55,11 @@ import pinocchio as pin
 
 from ocpkit.errors import RegistryError
 from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.planner import Plan, PlanStats
+from ocpkit.plan import Plan, finish
 from ocpkit.problem import Problem
-from ocpkit.robots import Robot
-from ocpkit.scenario import validate
+from ocpkit.robots import Robot, rigid_torque
 from ocpkit.trajectory import Samples, Trajectory
-from ocpkit.transcription.base import NLP
-from ocpkit.verify import verify
+from ocpkit.transcription import Discretization
 
 OMPL_PLANNERS = {"rrtconnect": "RRTConnect", "rrtstar": "RRTstar", "bitstar": "BITstar", "prm": "PRM"}
 REPAIR_ROUNDS = 8
@@ -287,15 +285,14 @@ class _TimedPath:
         """q, qd, qdd, tau at times t (m,), each (m, n)."""
         t = np.clip(t, *self.motion.path_interval)
         q, qd, qdd = self.motion.eval(t), self.motion.evald(t), self.motion.evaldd(t)
-        model, data = self.robot.model, self.data
-        rigid = np.array([pin.rnea(model, data, *row).copy() for row in zip(q, qd, qdd)])
-        return q, qd, qdd, rigid + self.robot.friction(qd)
+        return q, qd, qdd, rigid_torque(self.robot, q, qd, qdd, self.data) + self.robot.friction(qd)
 
 
 def _hold(problem: Problem) -> Trajectory:
     """Standing still at the start for time.min seconds: what a plan without a trajectory leaves the robot doing."""
     robot = problem.robot
-    gravity = pin.rnea(robot.model, robot.model.createData(), problem.start, np.zeros(robot.n), np.zeros(robot.n))
+    rest = np.zeros((1, robot.n))
+    gravity = rigid_torque(robot, problem.start[None, :], rest, rest)  # (1, n)
 
     def still(t: np.ndarray) -> Samples:
         t = np.asarray(t, dtype=float)
@@ -306,7 +303,7 @@ def _hold(problem: Problem) -> Trajectory:
 
 
 def _import_backends() -> float:
-    """Import OMPL and toppra; the seconds it took: the one-time set-up (about 1 s, then nearly 0)."""
+    """Import OMPL and toppra; the seconds it took: the one-time set-up (slow the first time, then nearly 0)."""
     start = time.perf_counter()
     import ompl.geometric  # noqa: F401
     import toppra.algorithm  # noqa: F401
@@ -318,8 +315,7 @@ def _import_backends() -> float:
 
 
 def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
-                     resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
-                     **_ignored: Any) -> Plan:
+                     resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01) -> Plan:
     """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (see the module docstring).
 
     `planner_name`: one of OMPL_PLANNERS. `planning_time` (s): OMPL's budget. RRTConnect stops at its first
@@ -327,33 +323,26 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     watches for a solution in a second thread, so their paths may depend on machine speed. `resolution` (rad):
     spacing of collision checks along straight joint-space segments. `grid_points`: TOPP-RA's path points.
     `margin` (m): clearance kept while planning, lowered to the start's or goal's clearance if that is smaller.
-    Options for other planners (knots, solver, ...) are ignored.
 
     Status: "verified" or "violated" (dense `verify`), "no_path" (OMPL found no exact path in its budget) or
     "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start."""
     if planner_name not in OMPL_PLANNERS:
         raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
-    validate(problem)
-    setup = _import_backends()
     began = time.perf_counter()
+    setup = _import_backends()
     ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
     free = FreeSpace(problem, min(margin, float(ends.min())))
     found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution)
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
              "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,
              "margin_m": free.margin}
-    method = {"planner": "ompl-toppra", "transcription": "toppra", "knots": grid_points, "dynamics": "pinocchio",
-              "solver": planner_name}
+    method = {"planner": "ompl-toppra", "path_planner": planner_name, "grid_points": grid_points}
 
-    def finish(trajectory: Trajectory, status: str | None, message: str) -> Plan:
-        """The Plan; status None means "verified" or "violated", as the dense verification says."""
-        verification = verify(problem, trajectory)
-        status = status or ("verified" if verification.ok else "violated")
-        return Plan(trajectory, status, verification,
-                    PlanStats(time.perf_counter() - began, setup, 0, 0, message, extra), method)
+    def done(trajectory: Trajectory, stopped: str | None, message: str) -> Plan:
+        return finish(problem, trajectory, stopped, method, began, setup_time=setup, message=message, extra=extra)
 
     if found.waypoints is None:
-        return finish(_hold(problem), "no_path", f"{planner_name}: no exact path within the budget")
+        return done(_hold(problem), "no_path", f"{planner_name}: no exact path within the budget")
     smoothing = time.perf_counter()
     path, rounds = _smooth_path(found.waypoints, free, resolution)
     timing = time.perf_counter()
@@ -361,20 +350,20 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     extra.update(smooth_time_s=timing - smoothing, toppra_time_s=time.perf_counter() - timing,
                  validity_checks=free.checks, waypoints=len(path.ss_waypoints), repair_rounds=rounds)
     if timed is None:
-        return finish(_hold(problem), "infeasible", "TOPP-RA: the path cannot be timed within the limits")
+        return done(_hold(problem), "infeasible", "TOPP-RA: the path cannot be timed within the limits")
     motion, knot_times = timed
     interpolant = _TimedPath(motion, problem.robot, problem.robot.model.createData())
     message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; "
                f"TOPP-RA: {grid_points} grid points")
-    return finish(Trajectory(interpolant(knot_times), interpolant), None, message)
+    return done(Trajectory(interpolant(knot_times), interpolant), None, message)
 
 
-def ompl_guess(problem: Problem, nlp: NLP, **baseline_options: Any) -> np.ndarray:
-    """A warm start for `nlp`: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`)
-    sampled on the NLP's grid by `nlp.encode`; the NLP's own guess if the baseline has no trajectory."""
+def ompl_guess(problem: Problem, discretization: Discretization, **baseline_options: Any) -> np.ndarray:
+    """A warm start: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`) sampled on the
+    discretization's grid by `encode`; its own straight-line guess if the baseline has no trajectory."""
     baseline = plan_ompl_toppra(problem, **baseline_options)
     if baseline.status in ("no_path", "infeasible"):
-        return nlp.initial_guess(problem)
-    return nlp.encode(baseline.trajectory)
+        return discretization.initial_guess(problem)
+    return discretization.encode(baseline.trajectory)
 
 

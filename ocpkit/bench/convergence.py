@@ -7,7 +7,7 @@ One paper case, two variants of it:
            convergence is spoilt and every method converges algebraically.
   smooth   μ = 30 and no obstacle (the workspace box stays): no bound is active, the optimum is smooth.
 
-For each registered transcription among chebyshev / hermite-simpson / trapezoidal and each knot count of the
+For each registered transcription among chebyshev / lgr / hermite-simpson / trapezoidal and each knot count of the
 sweep we plan once (`refinements=0`, so every point solves the same continuous problem: a refinement round
 would change the margin and limits depending on what it found) and record status, t_f, |t_f − t_f_ref|, the
 dense dynamics residual (the `dynamics` check of `verify`: max |τ − rnea(q, q̇, q̈) − friction| over a 1 ms grid,
@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ocpkit.bench.paper import measure, write_csv
+from ocpkit.bench.common import measure, write_csv
 from ocpkit.problem import Problem
 from ocpkit.scenario import load_scenario
 from ocpkit.scene import Scene
@@ -43,6 +43,7 @@ from ocpkit.transcription.base import TRANSCRIPTIONS
 DEFAULT_CASE = Path("scenarios/paper/case2.yaml")
 SWEEP = {"chebyshev": (6, 8, 10, 12, 16, 20, 24),
          "chebyshev×3": (4, 6, 8),  # three equal segments (h–p): 3N + 1 points
+         "lgr": (6, 8, 10, 12, 16, 20, 24),
          "hermite-simpson": (4, 6, 8, 12, 16, 24, 32),
          "trapezoidal": (8, 12, 16, 24, 32, 48, 64)}
 REFERENCES = {"paper": ("hermite-simpson", 80), "smooth": ("chebyshev", 32)}
@@ -51,8 +52,8 @@ STUDY_OPTIONS = {"refinements": 0, "solver_options": {"tol": 1e-9}}
 COLUMNS = ("variant", "transcription", "knots", "points", "status", "tf", "tf_ref", "tf_error",
            "dynamics_residual", "solve_time_s", "setup_time_s", "iterations")
 ERROR_FLOOR = 1e-12  # plotted in place of an error of exactly 0
-STYLE = {"chebyshev": ("tab:blue", "o"), "chebyshev×3": ("tab:purple", "D"), "hermite-simpson": ("tab:green", "s"),
-         "trapezoidal": ("tab:red", "^")}
+STYLE = {"chebyshev": ("tab:blue", "o"), "chebyshev×3": ("tab:purple", "D"), "lgr": ("tab:orange", "v"),
+         "hermite-simpson": ("tab:green", "s"), "trapezoidal": ("tab:red", "^")}
 
 
 @dataclass(frozen=True)
@@ -80,8 +81,8 @@ def method(label: str) -> tuple[str, dict]:
 
 
 def collocation_points(label: str, knots: int) -> int:
-    """Points where the dynamics are collocated: N + 1 knots (K N + 1 with K segments), plus N midpoints for
-    Hermite–Simpson."""
+    """Points where the dynamics residual is imposed: N + 1 knots (K N + 1 with K segments; LGR collocates
+    D X = h F at all but t_f of them), plus N midpoints for Hermite–Simpson."""
     name, options = method(label)
     return 2 * knots + 1 if name == "hermite-simpson" else options.get("segments", 1) * knots + 1
 

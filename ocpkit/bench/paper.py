@@ -8,19 +8,14 @@ Every method runs in the same process, so their times compare on the same machin
 
 from __future__ import annotations
 
-import csv
 import dataclasses
-import os
-import platform
 import statistics
-from dataclasses import dataclass
 from pathlib import Path
 
-from ocpkit.errors import ScenarioError
-from ocpkit.planner import Plan, plan
+from ocpkit.bench.common import load_all, machine, measure, write_csv
+from ocpkit.plan import Plan
 from ocpkit.problem import Problem
-from ocpkit.report import RESULT_COLUMNS, result_row, trajectory_header
-from ocpkit.scenario import load_scenario
+from ocpkit.report import result_row, trajectory_header
 from ocpkit.trajectory import write_json
 
 PAPER_TF = {12: [1.65, 1.23, 1.05, 1.08], 8: [1.98, 1.23, 1.09, 1.11]}
@@ -28,21 +23,6 @@ PAPER_SOLVE = {12: [2.55, 2.37, 2.39, 2.57], 8: [1.28, 1.75, 0.84, 1.32]}
 PAPER_SETUP = 5.9
 KNOTS = (12, 8)
 WIDTH = 24
-
-
-@dataclass(frozen=True)
-class Measured:
-    """One method on one case: the last plan, median computation time and set-up time (s)."""
-
-    plan: Plan
-    solve_time: float
-    setup_time: float
-
-
-def measure(problem: Problem, repeats: int, **options) -> Measured:
-    """Plan `problem` `repeats` times with `options` (as for `ocpkit.plan`)."""
-    plans = [plan(problem, **options) for _ in range(max(repeats, 1))]
-    return Measured(plans[-1], statistics.median(p.stats.solve_time for p in plans), plans[0].stats.setup_time)
 
 
 def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
@@ -85,8 +65,7 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
                  for (name, guess), m in seeding.items()]
         print(_seeding_table(seeding))
     write_csv(out / "results.csv", rows)
-    print(f"machine: {cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
-          f"computation times are medians of {repeats} runs per plan (seeding: 1 run)")
+    print(f"{machine()}; computation times are medians of {repeats} runs per plan (seeding: 1 run)")
     return rows
 
 
@@ -94,31 +73,15 @@ def _matched_to_baseline(problems: list[Problem]) -> list[Problem]:
     """The problems with what TOPP-RA cannot enforce switched off: torque-rate limits ×1000, μ = 0.001."""
     robots = {}
     for p in problems:
-        robots.setdefault(id(p.robot), dataclasses.replace(p.robot, taud_max=p.robot.taud_max * 1e3))
-    return [dataclasses.replace(p, robot=robots[id(p.robot)], mu=1e-3) for p in problems]
-
-
-def load_all(folder: Path) -> list[Problem]:
-    """Every scenario (*.yaml) in `folder`, sorted by file name; ScenarioError if there is none."""
-    files = sorted(folder.glob("*.yaml"))
-    if not files:
-        raise ScenarioError(f"no scenario files (*.yaml) in {folder}")
-    return [load_scenario(f) for f in files]
+        robots.setdefault(p.robot.key, dataclasses.replace(p.robot, taud_max=p.robot.taud_max * 1e3,
+                                                           key=f"{p.robot.key}:torque-rate-x1000"))
+    return [dataclasses.replace(p, robot=robots[p.robot.key], mu=1e-3) for p in problems]
 
 
 def _write_trajectory(out: Path, problem: Problem, result: Plan) -> None:
-    m = result.method
-    name = f"{problem.name}-{m['planner']}-{m['transcription']}-{m['knots']}.json"
+    name = "-".join([problem.name] + [str(result.method[k]) for k in ("planner", "transcription", "knots")
+                                      if k in result.method]) + ".json"
     write_json(out / "trajectories" / name, result.trajectory, trajectory_header(problem, result))
-
-
-def write_csv(path: Path, rows: list[dict], columns: tuple[str, ...] = RESULT_COLUMNS) -> None:
-    """`rows` as CSV with `columns`, creating the folder."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=columns)
-        writer.writeheader()
-        writer.writerows(rows)
 
 
 def _paper_table(problems: list[Problem], measured: dict, label: str, counts: tuple[int, ...]) -> str:
@@ -198,14 +161,3 @@ def _seeding_table(seeding: dict) -> str:
 
 def _row(label: str, knots: int, cells: list[str]) -> str:
     return f"{label:<20}{knots:>6}" + "".join(f"{c:>{WIDTH}}" for c in cells)
-
-
-def cpu_name() -> str:
-    """The CPU model name (for the machine line under a benchmark table)."""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()

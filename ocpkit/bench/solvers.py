@@ -12,13 +12,11 @@ the shape (the cases share one shape, so the first case pays it). Every combinat
 from __future__ import annotations
 
 import math
-import os
-import platform
 import statistics
 from dataclasses import dataclass
 from pathlib import Path
 
-from ocpkit.bench.paper import Measured, cpu_name, load_all, measure, write_csv
+from ocpkit.bench.common import Measured, load_all, machine, measure, write_csv
 from ocpkit.dynamics import DYNAMICS
 from ocpkit.errors import OcpkitError
 from ocpkit.problem import Problem
@@ -74,12 +72,13 @@ def combinations(solvers: tuple[str, ...] | None = None, dynamics: tuple[str, ..
     return [Combination(s, d, options) for s, options in entries for d in (dynamics or DYNAMICS.names())]
 
 
-def run_combination(problem: Problem, combination: Combination, knots: int, repeats: int,
+def run_combination(problem: Problem, combination: Combination, method: dict, repeats: int,
                     max_wall_time: float) -> Outcome:
-    """Plan `problem` with `combination`; an OcpkitError (the combination cannot run) becomes the reason."""
+    """Plan `problem` with `combination` and the transcription `method` (transcription, knots,
+    transcription_options); an OcpkitError (the combination cannot run) becomes the reason."""
     options = {"max_wall_time": max_wall_time, **dict(combination.options)}
     try:
-        return Outcome(measure(problem, repeats, knots=knots, solver=combination.solver,
+        return Outcome(measure(problem, repeats, **method, solver=combination.solver,
                                dynamics=combination.dynamics, solver_options=options))
     except OcpkitError as exc:
         return Outcome(None, str(exc))
@@ -87,21 +86,25 @@ def run_combination(problem: Problem, combination: Combination, knots: int, repe
 
 def run_solver_benchmark(scenarios: Path, out: Path, solvers: tuple[str, ...] | None = None,
                          dynamics: tuple[str, ...] | None = None, knots: int = 12, repeats: int = 1,
-                         max_wall_time: float = 30.0) -> list[dict]:
-    """Run every combination on every scenario in `scenarios`; print the table sorted by median solve time and
-    the recommended default; write `out`/results.csv (the paper suite's columns). `max_wall_time` (s) limits
-    each NLP solve."""
+                         max_wall_time: float = 30.0, transcription: str = "chebyshev",
+                         transcription_options: dict | None = None) -> list[dict]:
+    """Run every combination on every scenario in `scenarios` with the transcription (its `knots` and
+    `transcription_options`, e.g. {"staged": True} for fatrop's stage structure); print the table sorted by median
+    solve time and the recommended default; write `out`/results.csv (the paper suite's columns).
+    `max_wall_time` (s) limits each NLP solve."""
     problems = load_all(Path(scenarios))
+    method = {"transcription": transcription, "knots": knots, "transcription_options": transcription_options or {}}
     outcomes: dict[Combination, list[Outcome]] = {}
     for combination in combinations(solvers, dynamics):
-        outcomes[combination] = [run_combination(p, combination, knots, repeats, max_wall_time) for p in problems]
+        outcomes[combination] = [run_combination(p, combination, method, repeats, max_wall_time) for p in problems]
         print(f"  {combination.label} + {combination.dynamics}: "
               f"{', '.join(o.status for o in outcomes[combination])}", flush=True)
     rows = [_row(p, c, o) for c, row in outcomes.items() for p, o in zip(problems, row)]
     write_csv(out / "results.csv", rows)
-    print(solver_table(problems, outcomes, knots))
+    options = "".join(f" {k}={v}" for k, v in method["transcription_options"].items())
+    print(solver_table(problems, outcomes, f"{transcription}{options} at {knots} knots"))
     print(recommendation(outcomes))
-    print(f"machine: {cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}; solve times are "
+    print(f"{machine()}; solve times are "
           f"medians of {repeats} run(s) per plan, then over the cases; each NLP solve limited to {max_wall_time:g} s")
     return rows
 
@@ -122,13 +125,13 @@ def median_solve_time(row: list[Outcome]) -> float:
     return statistics.median(times) if times else math.inf
 
 
-def solver_table(problems: list[Problem], outcomes: dict[Combination, list[Outcome]], knots: int) -> str:
+def solver_table(problems: list[Problem], outcomes: dict[Combination, list[Outcome]], transcription: str) -> str:
     """One line per combination, fastest median solve time first; t_f deviation relative to REFERENCE."""
     reference = next((row for c, row in outcomes.items() if (c.solver, c.dynamics) == REFERENCE and not c.options),
                      None)
     head = (f"{'solver':<24}{'dynamics':<16}{'verified':>9}{'solve [s]':>11}{'set-up [s]':>11}{'iter':>6}"
             f"{'Δt_f [%]':>10}{'worst viol.':>12}  why not verified")
-    lines = [f"Solvers x dynamics backends, chebyshev at {knots} knots, {len(problems)} paper cases "
+    lines = [f"Solvers x dynamics backends, {transcription}, {len(problems)} cases "
              f"(Δt_f: largest deviation from {' + '.join(REFERENCE)})", head, "-" * len(head)]
     for combination, row in sorted(outcomes.items(), key=lambda item: median_solve_time(item[1])):
         ran = [o.measured for o in row if o.measured]

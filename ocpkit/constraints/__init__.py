@@ -1,7 +1,7 @@
-"""Path constraints: actuator limits and sphere collision, evaluated point by point."""
+"""Path constraints as plug-ins (registry `CONSTRAINTS`, entry-point group `ocpkit.constraints`):
+`state-limits`, `torque`, `torque-rate` (limits.py) and `collision` (collision.py)."""
 
-from ocpkit.constraints.base import Constraint, PointValues
-from ocpkit.constraints.collision import SphereCollision
-from ocpkit.constraints.limits import StateLimits, TorqueLimit, TorqueRateLimit
+from ocpkit.constraints.base import (CONSTRAINTS, DEFAULT_CONSTRAINTS, Constraint, Context, PointValues, Rows,
+                                     make_constraints)
 
-__all__ = ["Constraint", "PointValues", "SphereCollision", "StateLimits", "TorqueLimit", "TorqueRateLimit"]
+__all__ = ["CONSTRAINTS", "DEFAULT_CONSTRAINTS", "Constraint", "Context", "PointValues", "Rows", "make_constraints"]

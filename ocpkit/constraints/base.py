@@ -1,19 +1,34 @@
-"""The Constraint interface: path constraints evaluated at one time point, blind to the transcription.
+"""The Constraint interface: path constraints at one time point, blind to the transcription.
 
-The transcription supplies the symbolic values at a point (knot or extra check time) in its own way;
-a constraint turns them into `g` with numeric bounds `lower ≤ g ≤ upper`. Scene data that changes
-between queries of the same shape (obstacle positions, workspace box) enters through CasADi parameters.
+A constraint is a plug-in (registry `CONSTRAINTS`, entry-point group `ocpkit.constraints`). It is made for one
+problem (numeric set-up only, e.g. which collision terms can ever be active: that is its `shape`), names the
+NLP parameters it reads, and turns the symbolic values at a point into rows lower ≤ g ≤ upper. Two class
+attributes say how a transcription imposes it:
+
+  at_knots    "rows": rows at every point;  "bounds": at the knots it is the bounds `variable_bounds` gives
+              on the knot variables (rows only at check points between knots)
+  reads_rate  it reads dτ/ds, which has a kink at a knot (the slopes on either side differ), so it is
+              imposed once per one-sided slope there
+
+Scene data that changes between queries of the same shape (obstacle positions, the workspace box) enters
+through the constraint's parameters; the clearance margin and the limit scale a refinement round changes are
+shared parameters (`Context`).
 """
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import ClassVar, NamedTuple
 
 import casadi as ca
 import numpy as np
 
+from ocpkit.dynamics.base import Dynamics
+from ocpkit.errors import RegistryError
 from ocpkit.problem import Problem
+from ocpkit.registry import Registry
 
 
 @dataclass(frozen=True)
@@ -32,18 +47,69 @@ class PointValues:
     dt_ds: ca.SX
 
 
-class Constraint(Protocol):
-    """A path constraint lower ≤ g(point; p) ≤ upper."""
+@dataclass(frozen=True)
+class Context:
+    """What a constraint reads beyond the point: the dynamics backend (for kinematics), the shared NLP
+    parameters `margin` (m, added to every clearance) and `limit_scale` (fraction of the velocity, torque and
+    torque-rate limits in use), and its own parameter symbols by the names it declared."""
 
-    name: str
-    enforced_by_knot_bounds: bool  # True if a transcription's variable bounds at knots already imply it
+    dynamics: Dynamics
+    margin: ca.SX
+    limit_scale: ca.SX
+    parameters: dict[str, ca.SX]
 
-    @property
-    def parameters(self) -> ca.SX:
-        """Parameter symbols (column) this constraint reads; empty if none."""
 
-    def parameter_values(self, problem: Problem) -> np.ndarray:
-        """Numeric values for `parameters` taken from a problem of the same shape."""
+class Rows(NamedTuple):
+    """Constraint rows lower ≤ g ≤ upper: g a column (m, 1), the bounds numeric arrays (m,)."""
 
-    def evaluate(self, point: PointValues) -> tuple[ca.SX, np.ndarray, np.ndarray]:
-        """(g, lower, upper) at one point; g is a column, the bounds numeric arrays of its length."""
+    g: ca.SX
+    lower: np.ndarray
+    upper: np.ndarray
+
+
+class Constraint(ABC):
+    """A path constraint lower ≤ g(point; p) ≤ upper for the problem it was made for (module docstring)."""
+
+    name: ClassVar[str]
+    at_knots: ClassVar[str] = "rows"
+    reads_rate: ClassVar[bool] = False
+
+    def __init__(self, problem: Problem) -> None:
+        self.robot = problem.robot
+
+    def shape(self) -> tuple:
+        """Hashable: what of the problem, besides the robot, fixes this constraint's rows."""
+        return ()
+
+    def parameter_shapes(self) -> dict[str, tuple[int, int]]:
+        """Name → (rows, columns) of each NLP parameter this constraint reads; none by default."""
+        return {}
+
+    def parameter_values(self, problem: Problem) -> dict[str, np.ndarray]:
+        """Name → value (shaped as declared) of each parameter, for a problem of this constraint's shape."""
+        return {}
+
+    def variable_bounds(self, limit_scale: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """For at_knots = "bounds": knot variable name ("q", "qd", ...) → (lower, upper) (n,), with the
+        refinement's `limit_scale` applied."""
+        return {}
+
+    @abstractmethod
+    def evaluate(self, point: PointValues, context: Context) -> Rows:
+        """The rows at one point."""
+
+
+CONSTRAINTS: Registry[type[Constraint]] = Registry("constraint", "ocpkit.constraints")
+DEFAULT_CONSTRAINTS = ("state-limits", "torque", "torque-rate", "collision")
+"""The paper's path constraints, eqs. (6)–(8): what every planner imposes unless told otherwise."""
+
+
+def make_constraints(problem: Problem, kinds: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS
+                     ) -> list[Constraint]:
+    """The constraints `kinds` (registered names or Constraint classes) made for `problem`."""
+    made = [(CONSTRAINTS.get(kind) if isinstance(kind, str) else kind)(problem) for kind in kinds]
+    names = [c.name for c in made]
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise RegistryError(f"constraints listed more than once: {', '.join(repeated)}")
+    return made

@@ -1,59 +1,50 @@
-"""Actuator limits, eq. (6) of the paper: position, velocity, torque and torque-rate bounds."""
+"""Actuator limits, eq. (6) of the paper: position, velocity, torque and torque-rate bounds.
+
+Velocity, torque and torque rate are scaled by the shared `limit_scale` parameter (≤ 1), which a refinement
+round may lower; rows are dimensionless (value / limit)."""
 
 from __future__ import annotations
 
 import casadi as ca
 import numpy as np
 
-from ocpkit.constraints.base import PointValues
-from ocpkit.problem import Problem
-from ocpkit.robots import Robot
+from ocpkit.constraints.base import Constraint, Context, PointValues, Rows
 
 
-class _RobotLimit:
-    """Shared parts of the limit constraints: the robot's limits, velocity, torque and torque rate scaled by
-    `scale` (a CasADi expression ≤ 1 that a refinement round may lower; no parameters of their own)."""
+class StateLimits(Constraint):
+    """q_min ≤ q ≤ q_max and |q̇| ≤ q̇_max: the bounds of the knot variables, rows at check points."""
 
-    name = ""
-    enforced_by_knot_bounds = False
-    parameters = ca.SX(0, 1)
+    name = "state-limits"
+    at_knots = "bounds"
 
-    def __init__(self, robot: Robot, scale: ca.SX) -> None:
-        self.robot, self.scale = robot, scale
-
-    def parameter_values(self, problem: Problem) -> np.ndarray:
-        return np.zeros(0)
-
-
-class StateLimits(_RobotLimit):
-    """q_min ≤ q ≤ q_max and |qd| ≤ qd_max (qd scaled by qd_max); simple variable bounds at knots."""
-
-    name = "state_limits"
-    enforced_by_knot_bounds = True
-
-    def evaluate(self, point: PointValues) -> tuple[ca.SX, np.ndarray, np.ndarray]:
+    def variable_bounds(self, limit_scale: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         r = self.robot
-        ones = np.ones(r.n)
-        return (ca.vertcat(point.q, point.qd / ca.DM(r.qd_max) / self.scale), np.concatenate([r.q_lower, -ones]),
-                np.concatenate([r.q_upper, ones]))
+        return {"q": (r.q_lower, r.q_upper), "qd": (-r.qd_max * limit_scale, r.qd_max * limit_scale)}
+
+    def evaluate(self, point: PointValues, context: Context) -> Rows:
+        r, ones = self.robot, np.ones(self.robot.n)
+        return Rows(ca.vertcat(point.q, point.qd / ca.DM(r.qd_max) / context.limit_scale),
+                    np.concatenate([r.q_lower, -ones]), np.concatenate([r.q_upper, ones]))
 
 
-class TorqueLimit(_RobotLimit):
-    """|tau| ≤ tau_max (scaled by tau_max, g dimensionless)."""
+class TorqueLimit(Constraint):
+    """|τ| ≤ τ_max."""
 
     name = "torque"
 
-    def evaluate(self, point: PointValues) -> tuple[ca.SX, np.ndarray, np.ndarray]:
-        return point.tau / ca.DM(self.robot.tau_max) / self.scale, -np.ones(self.robot.n), np.ones(self.robot.n)
+    def evaluate(self, point: PointValues, context: Context) -> Rows:
+        ones = np.ones(self.robot.n)
+        return Rows(point.tau / ca.DM(self.robot.tau_max) / context.limit_scale, -ones, ones)
 
 
-class TorqueRateLimit(_RobotLimit):
-    """|dtau/dt| ≤ taud_max, written as |dtau_ds / taud_max| ≤ dt_ds so t_f never divides."""
+class TorqueRateLimit(Constraint):
+    """|dτ/dt| ≤ τ̇_max, written as |dτ/ds / τ̇_max| ≤ dt/ds so t_f never divides (one-sided rows)."""
 
-    name = "torque_rate"
+    name = "torque-rate"
+    reads_rate = True
 
-    def evaluate(self, point: PointValues) -> tuple[ca.SX, np.ndarray, np.ndarray]:
-        rate, limit = point.dtau_ds / ca.DM(self.robot.taud_max), point.dt_ds * self.scale
+    def evaluate(self, point: PointValues, context: Context) -> Rows:
+        rate, limit = point.dtau_ds / ca.DM(self.robot.taud_max), point.dt_ds * context.limit_scale
         n = self.robot.n
-        return (ca.vertcat(rate - limit, rate + limit),
-                np.concatenate([np.full(n, -np.inf), np.zeros(n)]), np.concatenate([np.zeros(n), np.full(n, np.inf)]))
+        return Rows(ca.vertcat(rate - limit, rate + limit), np.concatenate([np.full(n, -np.inf), np.zeros(n)]),
+                    np.concatenate([np.zeros(n), np.full(n, np.inf)]))

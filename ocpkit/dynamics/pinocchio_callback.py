@@ -14,7 +14,9 @@ evaluate, one graph). So `residual` on SX arguments returns the defect with a fr
 place of the pinocchio value and records the call; `lift(fields)` then turns the finished SX NLP into an MX
 one of three nodes: x, p ↦ the stacked arguments (one SX function), one callback call that evaluates all
 recorded points at once (one Python call per evaluation, not one per point), and x, p, values ↦ f, g (the
-original SX function). On MX arguments `residual` calls the callback directly; on numbers it calls pinocchio.
+original SX function). `lift` then forgets the recorded calls, so one instance serves several builds, one
+after the other (record, lift, record, lift). On MX arguments `residual` calls the callback directly; on numbers
+it calls pinocchio. These backends take no options.
 
 Hessian strategy: the callback provides values and first derivatives only, so the NLP has no exact Lagrangian
 Hessian. `exact_hessian = False` tells the solver to use a quasi-Newton approximation instead (IPOPT and
@@ -156,8 +158,13 @@ class _CallbackDefect:
 
     def __init__(self, robot: Robot) -> None:
         super().__init__(robot)
-        self._placeholders: list[ca.SX] = []  # one (n, 1) SX symbol per SX residual call
+        self._placeholders: list[ca.SX] = []  # one (n, 1) SX symbol per SX residual call since the last lift
         self._arguments: list[ca.SX] = []  # its [q; v; a] (3n, 1)
+
+    @property
+    def options(self) -> dict:
+        """Empty: the callback backends take no options."""
+        return {}
 
     def rigid_term(self, q, qd, a):
         """The algorithm at (q, qd, a): a placeholder on SX (recorded for `lift`), a callback on MX, numbers
@@ -178,20 +185,27 @@ class _CallbackDefect:
         return PinocchioCallback(self.robot.model, self.algorithm, points)
 
     def lift(self, fields: dict) -> dict:
-        """The SX NLP `fields` (x, p, f, g, ...) as an MX NLP in which the recorded placeholders are the
-        callback's values at their arguments; marks it `exact_hessian = False`. Without recorded calls the
-        fields come back unchanged but for that mark."""
+        """The SX NLP `fields` (x, p, f, g, ...) as an MX NLP in which the placeholders recorded since the last
+        lift are the callback's values at their arguments; marks it `exact_hessian = False` and forgets those
+        placeholders. Without recorded calls the fields come back unchanged but for that mark."""
         fields = dict(fields, exact_hessian=False)
-        if not self._placeholders:
+        placeholders, arguments = self._take_recorded()
+        if not placeholders:
             return fields
         x, p = fields["x"], fields["p"]
-        placeholders = ca.horzcat(*self._placeholders)  # (n, K)
-        arguments = ca.Function("pinocchio_arguments", [x, p], [ca.horzcat(*self._arguments)])
-        body = ca.Function("nlp_body", [x, p, placeholders], [fields["f"], fields["g"]])
+        stacked = ca.horzcat(*placeholders)  # (n, K)
+        arguments_of = ca.Function("pinocchio_arguments", [x, p], [ca.horzcat(*arguments)])
+        body = ca.Function("nlp_body", [x, p, stacked], [fields["f"], fields["g"]])
         X, P = ca.MX.sym("x", x.sparsity()), ca.MX.sym("p", p.sparsity())
-        values = self.callback(len(self._placeholders))(arguments(X, P))
+        values = self.callback(len(placeholders))(arguments_of(X, P))
         f, g = body(X, P, values)
         return dict(fields, x=X, p=P, f=f, g=g)
+
+    def _take_recorded(self) -> tuple[list[ca.SX], list[ca.SX]]:
+        """The recorded placeholders and their arguments, the records emptied."""
+        taken = self._placeholders, self._arguments
+        self._placeholders, self._arguments = [], []
+        return taken
 
 
 class PinocchioAba(_CallbackDefect, CasadiAba):

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -12,19 +12,23 @@ import pinocchio as pin
 import yaml
 
 from ocpkit.errors import RobotError
+from ocpkit.robots.friction import friction_slope, friction_torque
 
 DATA_DIR = Path(__file__).parent / "data"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Robot:
     """A serial robot with n joints and M collision spheres (SI units, radians).
 
     `model` holds only the listed joints (others are locked at zero). Sphere j is rigidly attached to
     pinocchio joint `sphere_joint[j]` (0 = universe) at `sphere_offset[j]` (metres, in that joint's frame).
+    `key` identifies the content it was built from (sha256 hex of the URDF and spec files' bytes); Robots
+    compare and hash by identity, and `robot_from_files` returns one object per key.
     """
 
     name: str
+    key: str
     model: pin.Model
     joint_names: tuple[str, ...]
     q_lower: np.ndarray  # (n,) rad
@@ -48,12 +52,12 @@ class Robot:
         return len(self.joint_names)
 
     def friction(self, qd: np.ndarray) -> np.ndarray:
-        """Joint friction torque (N m) at velocity qd (rad/s): viscous·qd + coulomb·tanh(qd / smoothing)."""
-        return self.viscous * qd + self.coulomb * np.tanh(qd / self.friction_smoothing)
+        """Joint friction torque (N m) at velocity qd (rad/s), shape of qd (..., n) (ocpkit.robots.friction)."""
+        return friction_torque(qd, self.viscous, self.coulomb, self.friction_smoothing, np.tanh)
 
     def friction_slope(self, qd: np.ndarray) -> np.ndarray:
-        """d friction / d qd (N m s / rad) at velocity qd (rad/s)."""
-        return self.viscous + self.coulomb / self.friction_smoothing / np.cosh(qd / self.friction_smoothing) ** 2
+        """d friction / d qd (N m s / rad) at velocity qd (rad/s), shape of qd (..., n)."""
+        return friction_slope(qd, self.viscous, self.coulomb, self.friction_smoothing, np.tanh)
 
 
 def builtin_robots() -> list[str]:
@@ -74,24 +78,53 @@ def load_robot(robot: str | dict[str, Any], base_dir: Path | None = None) -> Rob
     raise RobotError(f"robot must be a built-in name or {{urdf: ..., spec: ...}}, got {robot!r}")
 
 
+CACHE_SIZE = 16
+"""How many Robots `robot_from_files` keeps by content key."""
+_BY_KEY: dict[str, Robot] = {}
+
+
 def robot_from_files(urdf: Path, spec_file: Path) -> Robot:
     """Build a Robot from a URDF and a spec.yaml (schema in README, section 'Robot files').
 
-    Loads are cached per file pair, so problems on the same robot share one Robot (and one NLP shape)."""
-    for path in (urdf, spec_file):
-        if not Path(path).is_file():
-            raise RobotError(f"robot file not found: {path}")
-    return _load_cached(Path(urdf).resolve(), Path(spec_file).resolve())
+    Both files are read anew on every call; identical content gives the same Robot object (a bounded cache by
+    content key), so problems on one robot share one Robot and its builds, and an edited file a new Robot."""
+    urdf_bytes, spec_bytes = _read(Path(urdf)), _read(Path(spec_file))
+    key = _content_key(urdf_bytes, spec_bytes)
+    if key not in _BY_KEY:
+        _remember(_build(urdf_bytes, spec_bytes, key, Path(urdf), Path(spec_file)))
+    return _BY_KEY[key]
 
 
-@lru_cache(maxsize=16)
-def _load_cached(urdf: Path, spec_file: Path) -> Robot:
+def _content_key(urdf: bytes, spec: bytes) -> str:
+    """sha256 hex digest of a URDF's and a spec file's bytes (each length-prefixed, so no two pairs collide)."""
+    digest = hashlib.sha256()
+    for data in (urdf, spec):
+        digest.update(len(data).to_bytes(8, "little"))
+        digest.update(data)
+    return digest.hexdigest()
+
+
+def _read(path: Path) -> bytes:
+    if not path.is_file():
+        raise RobotError(f"robot file not found: {path}")
+    return path.read_bytes()
+
+
+def _remember(robot: Robot) -> None:
+    """Cache `robot` by its key, dropping the oldest entries beyond CACHE_SIZE."""
+    _BY_KEY[robot.key] = robot
+    while len(_BY_KEY) > CACHE_SIZE:
+        del _BY_KEY[next(iter(_BY_KEY))]
+
+
+def _build(urdf_bytes: bytes, spec_bytes: bytes, key: str, urdf: Path, spec_file: Path) -> Robot:
+    """The Robot of these file contents; the paths only name the files in error messages."""
     try:
-        spec = yaml.safe_load(Path(spec_file).read_text())
-        full = pin.buildModelFromUrdf(str(urdf))
-    except (yaml.YAMLError, ValueError, RuntimeError) as exc:
+        spec = yaml.safe_load(spec_bytes)
+        full = pin.buildModelFromXML(urdf_bytes.decode())
+    except (yaml.YAMLError, UnicodeDecodeError, ValueError, RuntimeError) as exc:
         raise RobotError(f"cannot read robot files {urdf}, {spec_file}: {exc}") from exc
-    return _robot_from_spec(full, spec, spec_file)
+    return _robot_from_spec(full, spec, key, spec_file)
 
 
 def _vector(spec: dict, path: str, n: int, spec_file: Path) -> np.ndarray:
@@ -106,7 +139,7 @@ def _vector(spec: dict, path: str, n: int, spec_file: Path) -> np.ndarray:
     return array
 
 
-def _robot_from_spec(full: pin.Model, spec: dict, spec_file: Path) -> Robot:
+def _robot_from_spec(full: pin.Model, spec: dict, key: str, spec_file: Path) -> Robot:
     if not isinstance(spec, dict) or "joints" not in spec or "name" not in spec:
         raise RobotError(f"{spec_file}: needs at least 'name' and 'joints'")
     joints = tuple(spec["joints"])
@@ -130,7 +163,7 @@ def _robot_from_spec(full: pin.Model, spec: dict, spec_file: Path) -> Robot:
     if smoothing <= 0:
         raise RobotError(f"{spec_file}: friction.smoothing must be > 0 rad/s")
     robot = Robot(
-        name=str(spec["name"]), model=model, joint_names=joints,
+        name=str(spec["name"]), key=key, model=model, joint_names=joints,
         q_lower=vec("limits.position.lower"), q_upper=vec("limits.position.upper"),
         qd_max=vec("limits.velocity"), tau_max=vec("limits.torque"), taud_max=vec("limits.torque_rate"),
         gear_ratios=vec("gear_ratios"), viscous=vec("friction.viscous"), coulomb=vec("friction.coulomb"),

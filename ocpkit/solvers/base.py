@@ -1,11 +1,13 @@
-"""The Solver interface: solve an NLP built by a transcription, from a guess, for given numbers.
+"""The Solver interface: solve an `NLP` from a guess, for given numbers.
 
 Every solver solves the same problem
 
     minimize f(w; p)  subject to  lbg ≤ g(w; p) ≤ ubg,  lbx ≤ w ≤ ubx
 
-with w (n_w,), p (n_p,), g (n_g,) taken from `NLP` (x, p, f, g). `prepare` does the one-time work
-for an NLP shape (derivative graphs, code generation); `solve` is one query.
+with w (n_w,), p (n_p,), g (n_g,) taken from `NLP` (x, p, f, g). A `Solver` holds options only;
+`Solver.prepare(nlp)` does the one-time work for one NLP (derivative graphs, solver set-up) and returns a
+`PreparedSolver`, whose `solve` is one query (guess, p, bounds). Whoever prepares keeps the PreparedSolver
+for as long as it wants to reuse it; solvers cache nothing.
 """
 
 from __future__ import annotations
@@ -16,8 +18,8 @@ from enum import Enum
 
 import numpy as np
 
+from ocpkit.nlp import NLP
 from ocpkit.registry import Registry
-from ocpkit.transcription.base import NLP
 
 
 class SolverStatus(str, Enum):
@@ -46,21 +48,31 @@ class SolverResult:
     lam_x: np.ndarray | None = field(default=None, repr=False)
 
 
+class PreparedSolver(ABC):
+    """A solver set up for one NLP (`nlp`): answers queries on it without redoing the set-up."""
+
+    nlp: NLP
+
+    @abstractmethod
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+        """Solve from `guess` (n_w,) with parameters `params` (n_p,) and variable bounds (lbx, ubx) (n_w,) each."""
+
+
 class Solver(ABC):
-    """An NLP solver; one instance may hold prepared state for several NLP shapes.
+    """An NLP solver's options; it holds no state of any NLP.
 
     Constructors take `max_iterations` and `max_wall_time` (s) limits plus solver-specific options."""
 
     name: str
 
     @abstractmethod
-    def prepare(self, nlp: NLP) -> None:
-        """One-time set-up for this NLP (idempotent)."""
+    def prepare(self, nlp: NLP) -> PreparedSolver:
+        """The one-time set-up for `nlp`; OptionError when this solver cannot take it."""
 
-    @abstractmethod
     def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
               bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
-        """Solve from `guess` with parameters `params` and variable bounds (lbx, ubx)."""
+        """One solve of `nlp` (prepared for this call only): see `PreparedSolver.solve`."""
+        return self.prepare(nlp).solve(guess, params, bounds)
 
 
 SOLVERS: Registry[type] = Registry("solver", "ocpkit.solvers")

@@ -2,9 +2,9 @@
 (SQP, exact Hessian, a CasADi QP solver per step), `blocksqp` (SQP with quasi-Newton Hessian blocks) and
 `fatrop` (structure-exploiting interior point, given our NLP as one stage).
 
-All share `CasadiNlpsol`: one nlpsol per NLP shape, limits and status mapping from `solver.stats()`
-(`success`, `return_status`, `iter_count`, `unified_return_status`), and a CasADi RuntimeError during a
-solve reported as status `failed` with its message instead of an exception.
+All share `CasadiNlpsol`: `prepare` creates the nlpsol of one NLP (a `PreparedNlpsol`); limits and status
+mapping from `solver.stats()` (`success`, `return_status`, `iter_count`, `unified_return_status`), and a
+CasADi RuntimeError during a solve reported as status `failed` with its message instead of an exception.
 
 Time limits: IPOPT has its own `max_wall_time`; sqpmethod stops through CasADi's `iteration_callback`
 (checked once per SQP iteration, reported as `User_Requested_Stop`). blocksqp and fatrop ignore the
@@ -19,13 +19,14 @@ import os
 import sys
 import time
 from abc import abstractmethod
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from ocpkit.errors import OptionError
-from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
-from ocpkit.transcription.base import NLP
+from ocpkit.nlp import NLP, Stages
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
 
 _UNIFIED_STATUS = {
     "SOLVER_RET_SUCCESS": SolverStatus.CONVERGED,
@@ -88,9 +89,38 @@ class _Deadline(ca.Callback):
         return [1 if time.perf_counter() > self.deadline else 0]
 
 
+@dataclass(frozen=True)
+class PreparedNlpsol(PreparedSolver):
+    """The nlpsol `function` of `nlp`, its deadline callback (for plugins that stop by callback, else None)
+    and the `owner` solver whose limits and status table apply."""
+
+    nlp: NLP
+    function: ca.Function
+    deadline: _Deadline | None
+    owner: CasadiNlpsol
+
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+        start = time.perf_counter()
+        if self.deadline is not None:
+            self.deadline.deadline = start + self.owner.max_wall_time
+        try:
+            with _silenced_stdout():
+                out = self.function(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=self.nlp.lbg,
+                                    ubg=self.nlp.ubg)
+            stats = self.function.stats()
+        except RuntimeError as exc:  # a plugin's assertion or failed evaluation: a status, not a crash
+            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
+                                time.perf_counter() - start, str(exc))
+        wall = time.perf_counter() - start
+        message = str(stats.get("return_status", stats.get("unified_return_status", "unknown")))
+        return SolverResult(np.asarray(out["x"]).ravel(), self.owner.status(stats, message, wall),
+                            self.owner.iterations(stats), wall, message, stats,
+                            np.asarray(out["lam_g"]).ravel(), np.asarray(out["lam_x"]).ravel())
+
+
 class CasadiNlpsol(Solver):
-    """A CasADi nlpsol plugin on the NLP (one compiled solver per NLP shape); subclasses give the plugin
-    name, its options and its return_status table. `max_wall_time` is in seconds."""
+    """A CasADi nlpsol plugin on the NLP; subclasses give the plugin name, its options and its return_status
+    table. `max_wall_time` is in seconds."""
 
     plugin: str
     statuses: dict = {}
@@ -100,51 +130,29 @@ class CasadiNlpsol(Solver):
 
     def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0) -> None:
         self.max_iterations, self.max_wall_time = max_iterations, max_wall_time
-        self._prepared: dict[tuple, tuple[ca.Function, _Deadline | None]] = {}
 
     @abstractmethod
     def plugin_options(self, nlp: NLP) -> dict:
         """nlpsol options of the plugin for this NLP (limits included)."""
 
-    def prepare(self, nlp: NLP) -> None:
-        if nlp.shape_key not in self._prepared:
-            problem = {"x": nlp.x, "p": nlp.p, "f": nlp.f, "g": nlp.g}
-            options = {"print_time": False, "error_on_fail": False, **self.plugin_options(nlp)}
-            deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel()) if self.stops_by_callback else None
-            if deadline is not None:
-                options["iteration_callback"] = deadline
-            try:
-                with _silenced_stdout():
-                    solver = ca.nlpsol(self.name, self.plugin, problem, options)
-            except RuntimeError as exc:  # an option or structure the plugin rejects: the caller's choice
-                raise OptionError(f"{self.name} cannot be set up for this NLP: {_last_line(exc)}") from exc
-            self._prepared[nlp.shape_key] = (solver, deadline)
-
-    def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
-              bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
-        self.prepare(nlp)
-        solver, deadline = self._prepared[nlp.shape_key]
-        start = time.perf_counter()
+    def prepare(self, nlp: NLP) -> PreparedNlpsol:
+        problem = {"x": nlp.x, "p": nlp.p, "f": nlp.f, "g": nlp.g}
+        options = {"print_time": False, "error_on_fail": False, **self.plugin_options(nlp)}
+        deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel()) if self.stops_by_callback else None
         if deadline is not None:
-            deadline.deadline = start + self.max_wall_time
+            options["iteration_callback"] = deadline
         try:
             with _silenced_stdout():
-                out = solver(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=nlp.lbg, ubg=nlp.ubg)
-            stats = solver.stats()
-        except RuntimeError as exc:  # a plugin's assertion or failed evaluation: a status, not a crash
-            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
-                                time.perf_counter() - start, str(exc))
-        wall = time.perf_counter() - start
-        message = str(stats.get("return_status", stats.get("unified_return_status", "unknown")))
-        return SolverResult(np.asarray(out["x"]).ravel(), self._status(stats, message, wall),
-                            self.iterations(stats), wall, message, stats,
-                            np.asarray(out["lam_g"]).ravel(), np.asarray(out["lam_x"]).ravel())
+                function = ca.nlpsol(self.name, self.plugin, problem, options)
+        except RuntimeError as exc:  # an option or structure the plugin rejects: the caller's choice
+            raise OptionError(f"{self.name} cannot be set up for this NLP: {_last_line(exc)}") from exc
+        return PreparedNlpsol(nlp, function, deadline, self)
 
     def iterations(self, stats: dict) -> int:
         """Iterations the plugin took, from its stats."""
         return int(stats.get("iter_count") or 0)
 
-    def _status(self, stats: dict, message: str, wall: float) -> SolverStatus:
+    def status(self, stats: dict, message: str, wall: float) -> SolverStatus:
         """Our status from the plugin's stats: its own table, then CasADi's unified status and the limits."""
         if message in self.statuses:
             return self.statuses[message]
@@ -189,8 +197,8 @@ class SqpMethod(CasadiNlpsol):
     """CasADi's SQP (`sqpmethod`) with exact Hessian (L-BFGS when the NLP has none) and line search.
 
     `qpsol` names the QP solver: qpoases (dense active set, the default: it handles the indefinite
-    Hessians of nonconvex NLPs, where osqp's convex ADMM diverges), osqp (sparse ADMM: about 10x faster
-    on the paper cases at 12 knots, where it converges), proxqp (hits the time limit on the paper cases),
+    Hessians of nonconvex NLPs, where osqp's convex ADMM diverges), osqp (sparse ADMM: faster on the paper
+    cases, where it converges), proxqp (hits the time limit on the paper cases),
     hpipm (needs a stage-wise OCP structure that our NLPs lack: refused with an OptionError).
     `convexify_strategy` ("regularize", "eigen-clip", "eigen-reflect") convexifies the Lagrangian Hessian:
     off (None) by default, as the paper cases converge without it, "regularize" stalls case 2 at the
@@ -248,14 +256,15 @@ class BlockSqp(CasadiNlpsol):
 
 
 class Fatrop(CasadiNlpsol):
-    """fatrop (structure-exploiting interior point) with exact Hessian, given our NLP as a single stage.
+    """fatrop (structure-exploiting interior point) with exact Hessian, given the NLP's stage structure.
 
-    fatrop wants a stage-wise OCP (x_{k+1} = f(x_k, u_k) with stage-local constraints). The pseudospectral
-    NLP has no such structure: the differentiation matrix couples every knot with every other, and the
-    time variable enters every stage (its automatic structure detection rejects our NLP). So it gets one
-    stage (N = 0) whose "controls" are all of w and whose stage constraints are all of g; its Riccati
-    recursion then is one dense factorization per iteration. It needs the exact Hessian: an NLP without one
-    (a callback dynamics backend) is refused with an OptionError. Extra keyword options go to fatrop verbatim."""
+    fatrop wants a stage-wise OCP: w = [x_0, u_0, ..., x_N], gap-closing rows x_{k+1} − F(x_k, u_k) = 0, every
+    other row and objective term reading one stage (ocpkit.nlp.Stages). A staged NLP (the mesh transcriptions
+    with `staged=True`) is handed over with that structure (manual mode), and fatrop's Riccati recursion runs
+    stage by stage. An NLP without it (pseudospectral: the differentiation matrix couples every knot with every
+    other) gets one stage (N = 0) whose "controls" are all of w and whose stage rows are all of g: one dense
+    factorization per iteration. It needs the exact Hessian: an NLP without one (a callback dynamics backend)
+    is refused with an OptionError. Extra keyword options go to fatrop verbatim."""
 
     name = plugin = "fatrop"
     statuses = {"0": SolverStatus.CONVERGED}
@@ -270,5 +279,17 @@ class Fatrop(CasadiNlpsol):
             raise OptionError("fatrop needs the exact Hessian, and this NLP's dynamics backend gives first "
                               "derivatives only; use a symbolic backend (casadi, casadi-rnea) or another solver")
         equality = [bool(e) for e in np.asarray(nlp.lbg) == np.asarray(nlp.ubg)]
-        return {"structure_detection": "manual", "N": 0, "nx": [0], "nu": [nlp.x.numel()],
-                "ng": [nlp.g.numel()], "equality": equality, "fatrop": self.options}
+        structure = _stages(nlp.stages) if nlp.stages else _single_stage(nlp)
+        return {"structure_detection": "manual", **structure, "equality": equality, "fatrop": self.options}
+
+
+def _stages(stages: Stages) -> dict:
+    """fatrop's stage options (N, nx, nu, ng) for an NLP with this stage structure (ocpkit.nlp.Stages): N
+    intervals, N + 1 stages."""
+    return {"N": len(stages.nx) - 1, "nx": list(stages.nx), "nu": list(stages.nu), "ng": list(stages.ng)}
+
+
+def _single_stage(nlp: NLP) -> dict:
+    """fatrop's stage options (N, nx, nu, ng) for `nlp` as one stage: no states, all of w (n_w) as its controls
+    and all of g (n_g) as its stage constraints."""
+    return {"N": 0, "nx": [0], "nu": [nlp.x.numel()], "ng": [nlp.g.numel()]}

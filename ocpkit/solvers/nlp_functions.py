@@ -1,5 +1,5 @@
 """CasADi functions of an NLP's (w, p) for the solvers that drive their own iterations in Python
-(`scipy_minimize`, `scp`): objective, constraints and their derivatives, built once per NLP shape."""
+(`scipy_minimize`, `scp`): objective, constraints and their derivatives, built once per NLP (in `prepare`)."""
 
 from __future__ import annotations
 
@@ -7,12 +7,12 @@ from dataclasses import dataclass
 
 import casadi as ca
 
-from ocpkit.transcription.base import NLP
+from ocpkit.nlp import NLP
 
 
 @dataclass(frozen=True)
 class NLPFunctions:
-    """CasADi functions of (w, p) for one NLP shape: f, ∇f (n_w,), g (n_g,), ∂g/∂w (n_g × n_w, sparse) and,
+    """CasADi functions of (w, p) for one NLP: f, ∇f (n_w,), g (n_g,), ∂g/∂w (n_g × n_w, sparse) and,
     when asked for, ∇²f and ∇²(vᵀg) (n_w × n_w) for constraint multipliers v (n_g,)."""
 
     f: ca.Function

@@ -1,28 +1,28 @@
 """The `pyomo` solver: the NLP as a Pyomo model, solved by ripopt (pyomo-ripopt's interior-point solver, run
 through Pyomo's AMPL .nl/.sol interface as the `ripopt` SolverFactory plugin).
 
-Translation (once per NLP shape, in `prepare`): the instructions of the SX function (w, p) ↦ (f, g) are read
-as a DAG (CasADi's work-vector slots are reused, so every operand is resolved to the instruction that wrote
-it) and replayed with Pyomo operations (`_UNARY`, `_BINARY`; any other operation is an OptionError naming it).
+Translation (once per NLP, in `prepare`, which returns it in a `PreparedRipopt`): the instructions of the SX
+function (w, p) ↦ (f, g) are read as a DAG (CasADi's work-vector slots are reused, so every operand is
+resolved to the instruction that wrote it) and replayed with Pyomo operations (`_UNARY`, `_BINARY`; any other
+operation is an OptionError naming it).
 w becomes the indexed Var `w` (n_w,), p the mutable Param `p` (n_p,), g the Constraint `g` (n_g,) with the
 NLP's lbg/ubg. A query then only sets p, the bounds (lbx == ubx fixes the variable, which the .nl writer
 turns into a constant), the starting point, and solves. An NLP lifted to MX around a Python callback (the
 `pinocchio` dynamics backend) has no SX graph and is refused with an OptionError.
 
 Shared subexpressions: the .nl format stores expression trees, so a DAG node used twice is written twice
-unless it is a named Pyomo Expression (an .nl "defined variable"). Written as plain trees, case 2 at 12
-knots (48k SX instructions) gives a 19 MB .nl (18 s to write); with every shared node (used more than once)
-named it is 0.7 MB (0.4 s). ripopt, however, expands defined variables back into one tree per constraint
+unless it is a named Pyomo Expression (an .nl "defined variable"). Written as plain trees the dynamics blow
+the .nl file up by more than an order of magnitude, and writing it dominates; with every shared node (used more
+than once) named it stays small. ripopt, however, expands defined variables back into one tree per constraint
 and takes its Hessian by one forward-over-reverse sweep per variable of that tree, so the dynamics
-constraints cost it about 1.2 s per Hessian (45 s per solve). So a shared node whose expanded tree exceeds
-`lift_above` nodes is lifted instead: an auxiliary Var `lifted[i]` with the equality `defines[i]`
-(lifted[i] == its expression), started at its value in the starting point; smaller shared nodes stay named
-Expressions. Lifting all shared nodes (~3600) makes ripopt's KKT solves the bottleneck (0.6 s/iteration);
-measured on case 2, lift_above = 300 (~260 lifted) gave the fastest solves (6 s, ~28 iterations, against
-10 to 45 s for 30, 100, 1000, 10⁴ and no lifting). The lifted problem has the same solutions and the same
-multipliers of g. A lifted node that depends on fixed variables only (e.g. the dynamics at a rest knot) is
-fixed at its value for the query: left free, its defining equality has one free variable, and ripopt then
-ended "optimal" with that equality violated by up to 7.5 (seen with the `casadi` backend on case 1).
+constraints make every Hessian slow. So a shared node whose expanded tree exceeds `lift_above` nodes is
+lifted instead: an auxiliary Var `lifted[i]` with the equality `defines[i]` (lifted[i] == its expression),
+started at its value in the starting point; smaller shared nodes stay named Expressions. Lifting all shared
+nodes makes ripopt's KKT solves the bottleneck instead, so the default `lift_above` sits in between: it gave
+the fastest solves of the thresholds tried (docs/architecture.md, "Measured"). The lifted problem has the same
+solutions and the same multipliers of g. A lifted node that depends on fixed variables only (e.g. the
+dynamics at a rest knot) is fixed at its value for the query: left free, its defining equality has one free
+variable, and ripopt then could end "optimal" with that equality grossly violated.
 
 Status, from ripopt's message (the .sol file's, which follows IPOPT's wording): `_STATUSES`, anything else
 is `failed` (then the starting point is returned: Pyomo does not load a solution with an error status), as
@@ -31,8 +31,8 @@ output, which is captured, never printed; Pyomo's warnings are captured as well.
 .sol, log) live in a Pyomo tempfile context that is released after every solve, failed or not.
 
 Limits: `max_iterations` is ripopt's max_iter, `max_wall_time` (s) its max_wall_time, which ripopt checks
-between iterations (the .nl write, ~0.3 s at 12 knots, comes before its clock starts). One iteration can
-take long (we saw a diverging case 3 run overrun a 30 s limit by 40 s), so the ripopt process is also killed
+between iterations (the .nl write comes before its clock starts). One iteration can take long (a diverging
+run can overrun the limit by more than the limit itself), so the ripopt process is also killed
 max(1 s, 1 %) after the limit (Pyomo's subprocess timeout): `time_limit` too, with the starting point.
 
 Multipliers: lam_g (n_g,) from the `dual` import Suffix; ripopt's constraint duals already follow CasADi's
@@ -60,11 +60,10 @@ from pyomo.common.tempfiles import TempfileManager
 from pyomo.opt import SolverResults
 from pyomo.opt import SolverStatus as PyomoStatus
 
-from ocpkit.dynamics.base import DYNAMICS
 from ocpkit.errors import OptionError
-from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
+from ocpkit.nlp import NLP
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
 from ocpkit.solvers.casadi_nlpsol import hessian_approximation
-from ocpkit.transcription.base import NLP
 
 _UNARY: dict[int, Callable] = {
     ca.OP_ASSIGN: lambda a: a, ca.OP_NEG: operator.neg, ca.OP_SQ: lambda a: a ** 2, ca.OP_TWICE: lambda a: 2 * a,
@@ -159,7 +158,7 @@ def _constraint(lower: float | None, body, upper: float | None):
 
 
 class _PyomoNlp:
-    """The Pyomo model of one NLP shape (see the module docstring) and the CasADi function that gives the
+    """The Pyomo model of one NLP (see the module docstring) and the CasADi function that gives the
     lifted nodes' values (n_lifted,) at (w, p), to start them consistently."""
 
     def __init__(self, nlp: NLP, lift_above: float) -> None:
@@ -246,11 +245,6 @@ class _PyomoNlp:
         return w, np.array(lam_g, dtype=float)
 
 
-def _dynamics_name(nlp: NLP) -> str:
-    """The registered dynamics backend named in the NLP's shape key (transcriptions put it there)."""
-    return next((part for part in nlp.shape_key if isinstance(part, str) and part in DYNAMICS.names()), "?")
-
-
 def _message(results: SolverResults) -> str:
     """ripopt's message without its "ripopt <version>: " prefix (Pyomo escapes its colons as \\x3a)."""
     return str(results.solver.message).replace("\\x3a", ":").partition(": ")[2]
@@ -260,6 +254,34 @@ def _diagnostics(log: str) -> dict[str, str]:
     """The "key: value" lines of ripopt's diagnostics block in its output (iterations, wall_time, ...)."""
     block = log.partition("--- ripopt diagnostics ---")[2].partition("--- end diagnostics ---")[0]
     return dict(line.split(": ", 1) for line in block.splitlines() if ": " in line)
+
+
+@dataclass(frozen=True)
+class PreparedRipopt(PreparedSolver):
+    """`nlp` translated to a Pyomo model (`translation`) and the `owner` solver whose options apply."""
+
+    nlp: NLP
+    translation: _PyomoNlp
+    owner: PyomoRipopt
+
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+        guess = np.asarray(guess, dtype=float)
+        self.translation.load(guess, np.asarray(params, dtype=float), *(np.asarray(b, dtype=float) for b in bounds))
+        options = {"hessian_approximation": hessian_approximation(self.nlp), **self.owner.options}
+        start = time.perf_counter()
+        try:
+            results, log = self.owner.run(self.translation.model, options)
+        except subprocess.TimeoutExpired:
+            wall = time.perf_counter() - start
+            return SolverResult(guess, SolverStatus.TIME_LIMIT, 0, wall, f"ripopt killed after {wall:.1f} s")
+        except (ApplicationError, OSError, ValueError) as exc:  # ripopt ended abnormally or wrote no solution
+            return SolverResult(guess, SolverStatus.FAILED, 0, time.perf_counter() - start,
+                                f"{type(exc).__name__}: {exc}")
+        wall = time.perf_counter() - start
+        message, stats = _message(results), _diagnostics(log)
+        w, lam_g = self.translation.solution() if results.solver.status in _LOADED else (guess, None)
+        return SolverResult(w, _STATUSES.get(message, SolverStatus.FAILED), int(stats.get("iterations", 0)), wall,
+                            message, {"solve_result_num": results.solver.id, **stats}, lam_g)
 
 
 class PyomoRipopt(Solver):
@@ -276,39 +298,15 @@ class PyomoRipopt(Solver):
         self.options = {"print_level": 0, "tol": 1e-6, "max_iter": max_iterations,
                         "max_wall_time": max_wall_time, **ripopt_options}
         self._ripopt = pyo.SolverFactory("ripopt")
-        self._prepared: dict[tuple, _PyomoNlp] = {}
 
-    def prepare(self, nlp: NLP) -> None:
+    def prepare(self, nlp: NLP) -> PreparedRipopt:
         if isinstance(nlp.x, ca.MX):
-            raise OptionError(f"pyomo translates symbolic SX graphs; dynamics backend '{_dynamics_name(nlp)}' "
-                              "evaluates through a callback (the NLP is MX), use an SX backend (dynamics 'casadi' "
-                              "or 'casadi-rnea') or a CasADi solver such as ipopt instead")
-        if nlp.shape_key not in self._prepared:
-            self._prepared[nlp.shape_key] = _PyomoNlp(nlp, self.lift_above)
+            raise OptionError("pyomo translates symbolic SX graphs, and this NLP is MX: its dynamics backend "
+                              "evaluates through a callback; use an SX backend (dynamics 'casadi' or 'casadi-rnea') "
+                              "or a CasADi solver such as ipopt instead")
+        return PreparedRipopt(nlp, _PyomoNlp(nlp, self.lift_above), self)
 
-    def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
-              bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
-        self.prepare(nlp)
-        prepared = self._prepared[nlp.shape_key]
-        guess = np.asarray(guess, dtype=float)
-        prepared.load(guess, np.asarray(params, dtype=float), *(np.asarray(b, dtype=float) for b in bounds))
-        options = {"hessian_approximation": hessian_approximation(nlp), **self.options}
-        start = time.perf_counter()
-        try:
-            results, log = self._run(prepared.model, options)
-        except subprocess.TimeoutExpired:
-            wall = time.perf_counter() - start
-            return SolverResult(guess, SolverStatus.TIME_LIMIT, 0, wall, f"ripopt killed after {wall:.1f} s")
-        except (ApplicationError, OSError, ValueError) as exc:  # ripopt ended abnormally or wrote no solution
-            return SolverResult(guess, SolverStatus.FAILED, 0, time.perf_counter() - start,
-                                f"{type(exc).__name__}: {exc}")
-        wall = time.perf_counter() - start
-        message, stats = _message(results), _diagnostics(log)
-        w, lam_g = prepared.solution() if results.solver.status in _LOADED else (guess, None)
-        return SolverResult(w, _STATUSES.get(message, SolverStatus.FAILED), int(stats.get("iterations", 0)), wall,
-                            message, {"solve_result_num": results.solver.id, **stats}, lam_g)
-
-    def _run(self, model: pyo.ConcreteModel, options: dict) -> tuple[SolverResults, str]:
+    def run(self, model: pyo.ConcreteModel, options: dict) -> tuple[SolverResults, str]:
         """Solve `model` with ripopt quietly; (Pyomo's results, ripopt's output). The solution is loaded
         into the model unless ripopt reports an error status. ripopt is killed (subprocess.TimeoutExpired)
         once it overruns `max_wall_time` by max(1 s, 1 %). Temporary files are removed on return."""

@@ -16,13 +16,14 @@ from __future__ import annotations
 
 import time
 from abc import abstractmethod
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.optimize as so
 
-from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
+from ocpkit.nlp import NLP
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
 from ocpkit.solvers.nlp_functions import NLPFunctions
-from ocpkit.transcription.base import NLP
 
 
 class _Reduced:
@@ -76,6 +77,36 @@ class _Clock:
             raise StopIteration
 
 
+@dataclass(frozen=True)
+class PreparedMinimize(PreparedSolver):
+    """The CasADi `functions` of `nlp` and the `owner` solver whose method and options apply."""
+
+    nlp: NLP
+    functions: NLPFunctions
+    owner: ScipyMinimize
+
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+        owner = self.owner
+        lbx, ubx = (np.asarray(b, dtype=float) for b in bounds)
+        reduced = _Reduced(self.functions, np.asarray(params, dtype=float), lbx, ubx)
+        free = reduced.free
+        z0 = np.clip(np.asarray(guess, dtype=float), lbx, ubx)[free]
+        start = time.perf_counter()
+        try:
+            result = so.minimize(reduced.f, z0, method=owner.method, jac=reduced.grad_f,
+                                 hess=reduced.objective_hessian() if owner.hessians else None,
+                                 bounds=so.Bounds(lbx[free], ubx[free]),
+                                 constraints=owner.constraints(self.nlp, reduced), options=owner.options,
+                                 callback=_Clock(owner.max_wall_time))
+        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # failed evaluation or factorization
+            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
+                                time.perf_counter() - start, f"{type(exc).__name__}: {exc}")
+        wall = time.perf_counter() - start
+        status = owner.statuses.get(int(result.status), SolverStatus.FAILED)
+        return SolverResult(reduced.full(result.x), status, int(getattr(result, "nit", 0)), wall,
+                            str(result.message), {"status": int(result.status), "nfev": result.nfev})
+
+
 class ScipyMinimize(Solver):
     """scipy.optimize.minimize with one method; subclasses give the method, how constraints are passed
     and the meaning of SciPy's status codes. `max_wall_time` is in seconds; `options` go to minimize's
@@ -88,38 +119,14 @@ class ScipyMinimize(Solver):
     def __init__(self, max_iterations: int = 500, max_wall_time: float = 60.0, **options) -> None:
         self.max_iterations, self.max_wall_time = max_iterations, max_wall_time
         self.options = {"maxiter": max_iterations, **options}
-        self._prepared: dict[tuple, NLPFunctions] = {}
 
-    def prepare(self, nlp: NLP) -> None:
-        if nlp.shape_key not in self._prepared:
-            exact = self.hessians and nlp.exact_hessian
-            self._prepared[nlp.shape_key] = NLPFunctions.build(nlp, exact, exact)
+    def prepare(self, nlp: NLP) -> PreparedMinimize:
+        exact = self.hessians and nlp.exact_hessian
+        return PreparedMinimize(nlp, NLPFunctions.build(nlp, exact, exact), self)
 
     @abstractmethod
     def constraints(self, nlp: NLP, reduced: _Reduced) -> list:
         """The constraints lbg ≤ g ≤ ubg in the form this method takes."""
-
-    def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
-              bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
-        self.prepare(nlp)
-        lbx, ubx = (np.asarray(b, dtype=float) for b in bounds)
-        reduced = _Reduced(self._prepared[nlp.shape_key], np.asarray(params, dtype=float), lbx, ubx)
-        free = reduced.free
-        z0 = np.clip(np.asarray(guess, dtype=float), lbx, ubx)[free]
-        start = time.perf_counter()
-        try:
-            result = so.minimize(reduced.f, z0, method=self.method, jac=reduced.grad_f,
-                                 hess=reduced.objective_hessian() if self.hessians else None,
-                                 bounds=so.Bounds(lbx[free], ubx[free]),
-                                 constraints=self.constraints(nlp, reduced), options=self.options,
-                                 callback=_Clock(self.max_wall_time))
-        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # failed evaluation or factorization
-            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
-                                time.perf_counter() - start, f"{type(exc).__name__}: {exc}")
-        wall = time.perf_counter() - start
-        status = self.statuses.get(int(result.status), SolverStatus.FAILED)
-        return SolverResult(reduced.full(result.x), status, int(getattr(result, "nit", 0)), wall,
-                            str(result.message), {"status": int(result.status), "nfev": result.nfev})
 
 
 class ScipySlsqp(ScipyMinimize):

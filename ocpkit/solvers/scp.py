@@ -32,24 +32,23 @@ Every QP solved (second-order corrections included) counts towards `max_iteratio
 `max_wall_time` is checked before each QP (→ TIME_LIMIT); a QP solver failure → FAILED with its message.
 The result carries lam_g from the last QP's constraint duals (the ℓ1 QP's multipliers, |lam_g| ≤ ρ).
 
-Choices, measured with `ocpkit.plan(..., knots=12)` on the paper cases 1-4 (n_w = 385, n_g = 2450, Jacobian
-nnz 20905): all four verified, t_f within 0.03 % of IPOPT's, in 56-70 QPs and 6-9 s (IPOPT: 0.3-0.6 s); the
-time is Clarabel's (~0.1 s per QP, ~15 interior-point iterations; cvxpy adds ~2 ms, the NLP evaluations ~10 ms).
-- The QP is built once per NLP shape as a cvxpy Problem with Parameters (DPP), J and the Cholesky factor of H
-  as *sparse* Parameters: compiling takes 0.04 s, re-solving adds ~2 ms, against ~0.05 s of
-  canonicalization per QP when rebuilt each time. (J written as dense selection matrices times a Parameter
-  vector of its nonzeros, the way without sparse Parameters, takes 12 s to compile.)
-- Clarabel over OSQP: OSQP needs 2800-20000 ADMM iterations (0.8-18 s) on the same QPs and still ends
-  inaccurate. HiGHS rejects the semidefinite QP. Clarabel's `iterative_refinement_enable=False` (an extra
-  option) saves ~20 % with unchanged results on cases 1-4; the default keeps Clarabel's settings.
-- H = ∇²f: its diagonal alone takes 64-98 QPs against 56-70; the Lagrangian Hessian made PSD by eigenvalue
-  clipping (a prototype) takes as many QPs as ∇²f on case 2 but is dense, which doubles the QP time.
-- ρ starts at 1: IPOPT's multipliers on the paper cases stay below 0.4, and TrajOpt's 10 makes every step
-  trade objective for feasibility: 138-179 QPs.
+Choices (each compared on the paper cases; the figures are in docs/architecture.md, "Measured"). Almost all
+of the time is spent in the QP solver.
+- The QP is built once per NLP (in `prepare`) as a cvxpy Problem with Parameters (DPP), J and the Cholesky
+  factor of H as *sparse* Parameters, so a QP is re-solved without canonicalizing it again; rebuilding it per
+  QP costs more than the re-solve, and J as dense selection matrices times a Parameter vector of its nonzeros
+  (the way without sparse Parameters) is slow to compile.
+- Clarabel over OSQP: OSQP needs thousands of ADMM iterations on the same QPs and still ends inaccurate.
+  HiGHS rejects the semidefinite QP. Clarabel's `iterative_refinement_enable=False` (an extra option) is
+  somewhat faster with unchanged results on the paper cases; the default keeps Clarabel's settings.
+- H = ∇²f: its diagonal alone needs more QPs; the Lagrangian Hessian made PSD by eigenvalue clipping (a
+  prototype) needs as many QPs but is dense, which makes each QP slower.
+- ρ starts at 1: IPOPT's multipliers on the paper cases stay below 1, and TrajOpt's 10 makes every step
+  trade objective for feasibility (far more QPs).
 - The second-order correction: without it the ℓ1 merit rejects the minimum-time problems' good steps (the
-  Maratos effect) and case 2 takes 192 QPs instead of 62.
+  Maratos effect), and the QP count multiplies.
 - The relative scale s: with the bound widths alone (1 for unbounded variables) the accelerations, which grow
-  as 1/t_f², move by a fixed amount per step: case 2 takes 83 QPs instead of 62.
+  as 1/t_f², move by a fixed amount per step, and more QPs are needed.
 """
 
 from __future__ import annotations
@@ -65,9 +64,9 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
-from ocpkit.solvers.base import Solver, SolverResult, SolverStatus
+from ocpkit.nlp import NLP
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
 from ocpkit.solvers.nlp_functions import NLPFunctions
-from ocpkit.transcription.base import NLP
 
 ACCEPT, POOR, GOOD = 0.1, 0.25, 0.75
 """Ratio thresholds: accept a step, halve Δ below POOR, double it above GOOD (and try the correction below)."""
@@ -206,7 +205,7 @@ def _cvxpy_quiet() -> Iterator[None]:
 
 
 class _Subproblem:
-    """The convex QP of one NLP shape (see the module docstring) as a cvxpy Problem with Parameters: the
+    """The convex QP of one NLP (see the module docstring) as a cvxpy Problem with Parameters: the
     model (∇f, J, the Cholesky factor R of H, ρ) is set once per linearization, the constant term g and the
     trust-region box per solve. Parameters: ∇f (n_w,), J (n_g × n_w, sparse), R (n_w × n_w, sparse upper
     triangular), ρ ≥ 0, the finite sides lbg − g and ubg − g, and the box lo, hi (n_w,)."""
@@ -258,14 +257,6 @@ class _Subproblem:
         return np.asarray(self.d.value), lam_g
 
 
-@dataclass(frozen=True)
-class _Shape:
-    """What `prepare` builds for one NLP shape."""
-
-    functions: NLPFunctions
-    subproblem: _Subproblem
-
-
 @dataclass
 class _Settings:
     """The solver's options (see `SequentialConvex`)."""
@@ -293,12 +284,13 @@ class _Model:
 class _Run:
     """One solve: the iteration state (iterate, penalty ρ, radius Δ, counters) and its steps."""
 
-    def __init__(self, shape: _Shape, nlp: NLP, settings: _Settings, params: np.ndarray,
-                 bounds: tuple[np.ndarray, np.ndarray], curvature: _Curvature) -> None:
-        self.shape, self.settings, self.curvature = shape, settings, curvature
+    def __init__(self, prepared: PreparedScp, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+                 curvature: _Curvature) -> None:
+        nlp, settings = prepared.nlp, prepared.settings
+        self.subproblem, self.settings, self.curvature = prepared.subproblem, settings, curvature
         self.lbx, self.ubx = (np.asarray(b, dtype=float) for b in bounds)
         self.free = self.lbx < self.ubx
-        self.evaluate = _Evaluator(shape.functions, params, np.asarray(nlp.lbg, float), np.asarray(nlp.ubg, float))
+        self.evaluate = _Evaluator(prepared.functions, params, np.asarray(nlp.lbg, float), np.asarray(nlp.ubg, float))
         self.rho, self.radius = settings.penalty, settings.trust_radius
         self.deadline = time.perf_counter() + settings.max_wall_time
         self.qps, self.accepted, self.corrections = 0, 0, 0
@@ -314,7 +306,7 @@ class _Run:
 
     def model(self, point: _Point) -> _Model:
         """Set the subproblem's model at `point` (fixed variables masked out) and the trust-region scale."""
-        subproblem, mask = self.shape.subproblem, self.free.astype(float)
+        subproblem, mask = self.subproblem, self.free.astype(float)
         factor = _cholesky_upper(self.curvature.matrix(point) * np.outer(mask, mask))
         jac = point.jac.copy()
         jac.data *= mask[subproblem.jac_pattern[1]]
@@ -329,7 +321,7 @@ class _Run:
         lo = np.where(self.free, np.maximum(self.lbx - w, -reach), -1.0)
         hi = np.where(self.free, np.minimum(self.ubx - w, reach), 1.0)
         self.qps += 1
-        d, self.lam_g = self.shape.subproblem.solve(g, lo, hi, self.settings.qp_solver, self.settings.qp_options)
+        d, self.lam_g = self.subproblem.solve(g, lo, hi, self.settings.qp_solver, self.settings.qp_options)
         return np.where(self.free, np.clip(d, lo, hi), 0.0)
 
     def predicted(self, model: _Model, d: np.ndarray) -> float:
@@ -412,6 +404,31 @@ class _Run:
                 "objective": point.f}
 
 
+@dataclass(frozen=True)
+class PreparedScp(PreparedSolver):
+    """The CasADi `functions` of `nlp`, its compiled convex `subproblem` and the solver's `settings`."""
+
+    nlp: NLP
+    functions: NLPFunctions
+    subproblem: _Subproblem
+    settings: _Settings
+
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+        params = np.asarray(params, dtype=float)
+        curvature = _ExactCurvature(self.functions, params) if self.functions.hess_f is not None \
+            else _DampedBfgs(self.nlp.x.numel())
+        start = time.perf_counter()
+        run = _Run(self, params, bounds, curvature)
+        try:
+            point, status, message = run.run(np.asarray(guess, dtype=float))
+        except cp.error.SolverError as exc:
+            return run.failed(guess, start, f"QP solver failed: {exc}")
+        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # a failed evaluation or factorization
+            return run.failed(guess, start, f"{type(exc).__name__}: {exc}")
+        return SolverResult(point.w, status, run.qps, time.perf_counter() - start, message, run.stats(point),
+                            run.lam_g)
+
+
 class SequentialConvex(Solver):
     """Sequential convex programming with an ℓ1 penalty, box trust region and second-order corrections
     (module docstring). `max_iterations` counts convex subproblems; `max_wall_time` is in seconds; `tol`
@@ -426,11 +443,8 @@ class SequentialConvex(Solver):
                  trust_radius: float = 0.1, **qp_options) -> None:
         self.settings = _Settings(max_iterations, max_wall_time, tol, qp_solver, penalty, max_penalty, trust_radius,
                                   qp_options)
-        self._prepared: dict[tuple, _Shape] = {}
 
-    def prepare(self, nlp: NLP) -> None:
-        if nlp.shape_key in self._prepared:
-            return
+    def prepare(self, nlp: NLP) -> PreparedScp:
         functions = NLPFunctions.build(nlp, objective_hessian=nlp.exact_hessian, constraint_hessian=False)
         n_w = nlp.x.numel()
         hessian_pattern = _hessian_pattern(functions, n_w)
@@ -438,22 +452,4 @@ class SequentialConvex(Solver):
         subproblem = _Subproblem(jac_pattern, _factor_pattern(hessian_pattern), np.asarray(nlp.lbg, float),
                                  np.asarray(nlp.ubg, float), n_w)
         subproblem.compile(self.settings.qp_solver)
-        self._prepared[nlp.shape_key] = _Shape(functions, subproblem)
-
-    def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
-              bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
-        self.prepare(nlp)
-        shape = self._prepared[nlp.shape_key]
-        params = np.asarray(params, dtype=float)
-        curvature = _ExactCurvature(shape.functions, params) if shape.functions.hess_f is not None \
-            else _DampedBfgs(nlp.x.numel())
-        start = time.perf_counter()
-        run = _Run(shape, nlp, self.settings, params, bounds, curvature)
-        try:
-            point, status, message = run.run(np.asarray(guess, dtype=float))
-        except cp.error.SolverError as exc:
-            return run.failed(guess, start, f"QP solver failed: {exc}")
-        except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # a failed evaluation or factorization
-            return run.failed(guess, start, f"{type(exc).__name__}: {exc}")
-        return SolverResult(point.w, status, run.qps, time.perf_counter() - start, message, run.stats(point),
-                            run.lam_g)
+        return PreparedScp(nlp, functions, subproblem, self.settings)

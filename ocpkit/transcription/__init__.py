@@ -1,6 +1,7 @@
-"""Transcriptions (registry `TRANSCRIPTIONS`, entry-point group `ocpkit.transcriptions`): `chebyshev` (the paper's
-pseudospectral method), `trapezoidal` and `hermite-simpson` (local collocation on a uniform mesh, Kelly 2017)."""
+"""Transcriptions (registry `TRANSCRIPTIONS`, entry-point group `ocpkit.transcriptions`): pseudospectral
+`chebyshev` (the paper's), `lgl` and `lgr`, and local collocation `trapezoidal` and `hermite-simpson` on a
+uniform mesh; their equations are in docs/transcription.md."""
 
-from ocpkit.transcription.base import NLP, TRANSCRIPTIONS, Transcription
+from ocpkit.transcription.base import TRANSCRIPTIONS, Discretization, Transcription
 
-__all__ = ["NLP", "TRANSCRIPTIONS", "Transcription"]
+__all__ = ["TRANSCRIPTIONS", "Discretization", "Transcription"]

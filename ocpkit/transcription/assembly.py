@@ -1,146 +1,152 @@
 """What every transcription's NLP shares, so each transcription module holds only its own math.
 
-A transcription supplies its collocation defects, its interpolant (and through it the values at check times
-between knots), its torque rate dτ/ds and its jerk quadrature. `Assembly` does the rest the same way for all:
+A transcription creates its variables through `Assembly.w` (a Layout: the order of creation is the order in
+w) and adds its rows in the order it wants them; the assembly supplies the rest the same way for all:
 
-- the path constraints (`StateLimits`, `TorqueLimit`, `TorqueRateLimit`, `SphereCollision`) at one point,
-  fed by `point(q, q̇, q̈, u, du/ds)` with the joint torque τ = τ_max ∘ u + friction(q̇) and its rate
-  dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈, where dt/ds is the transcription's (t_f/2 on Chebyshev's
-  s ∈ [-1, 1], h = t_f/N on a mesh interval's σ ∈ [0, 1]), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and
-  t_f never divides;
+- the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, ...];
+- the values at a point, `point(node, du_ds, dt_ds)`: joint torque τ = τ_max ∘ u + friction(q̇) and its rate
+  dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈, where dt/ds is the transcription's (t_f/(2K) on a
+  pseudospectral segment, h = t_f/N on a mesh interval), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f
+  never divides;
+- the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base);
 - the dynamic defect residual(q, q̇, q̈, τ_max u) at a collocation point;
-- the rows g with their bounds lbg ≤ g ≤ ubg, in the order the transcription adds them;
-- the parameter vector p = [μ, margin, limit_scale, collision parameters, the transcription's own], and its
-  numbers for a problem: the clearance margin (grown by a refinement) is capped at MAX_MARGIN and at half the
-  start's and goal's clearance, both fixed, so a larger margin would make the NLP infeasible;
-- the variable bounds x = [knot columns [q; q̇; q̈; u], free variables, t_f]: position and velocity limits
-  at every knot (velocity scaled by the refinement's limit_scale), start and goal with rest (q̇ = q̈ = 0,
-  eq. (10)) at the two end knots;
-- the paper's initial guess (the straight joint-space line at t_f = time.guess) and the knot columns of any
-  trajectory, u being its rigid-body torque rnea(q, q̇, q̈) / τ_max (see chebyshev.py for why u is that).
+- the rows lbg ≤ g ≤ ubg in the order they were added, and the finished `NLP`;
+- the knot columns [q, q̇, q̈, u] of any trajectory (u is its rigid-body torque rnea(q, q̇, q̈) / τ_max, see
+  docs/transcription.md, section "The control u", for why) and the paper's straight-line guess.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
 import casadi as ca
 import numpy as np
-import pinocchio as pin
 
-from ocpkit.constraints import PointValues, SphereCollision, StateLimits, TorqueLimit, TorqueRateLimit
-from ocpkit.constraints.collision import MAX_MARGIN, active_terms
-from ocpkit.dynamics.base import make_dynamics
-from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.constraints import Constraint, Context, PointValues, Rows
+from ocpkit.dynamics import Dynamics
+from ocpkit.nlp import NLP, Layout, Stages
 from ocpkit.problem import Problem
-from ocpkit.robots import Robot
+from ocpkit.robots import Robot, rigid_torque
 from ocpkit.trajectory import Samples, Trajectory
-from ocpkit.transcription.base import Refinement
+
+
+class Node(NamedTuple):
+    """[q, q̇, q̈, u] at one point: CasADi (n, 1) columns, or NumPy (m, n) rows when decoding."""
+
+    q: Any
+    qd: Any
+    qdd: Any
+    u: Any
 
 
 class Assembly:
-    """The shared symbols and constraint rows of one NLP under construction (see the module docstring).
+    """The variables, parameters and rows of one NLP under construction (see the module docstring)."""
 
-    `margin` (m) is the default clearance margin; `dt_ds` the transcription's dt/ds (a CasADi expression)."""
-
-    def __init__(self, problem: Problem, dynamics_name: str, margin: float, dt_ds: ca.SX) -> None:
-        robot = problem.robot
-        self.robot, self.margin, self.dt_ds = robot, margin, dt_ds
-        self.dynamics = make_dynamics(dynamics_name, robot)
-        self.tau_max = ca.DM(robot.tau_max)
-        self.mu, self.margin_symbol, self.limit_scale = ca.SX.sym("mu"), ca.SX.sym("margin"), ca.SX.sym("limit_scale")
-        self.torque_rate = TorqueRateLimit(robot, self.limit_scale)
-        self.constraints = [StateLimits(robot, self.limit_scale), TorqueLimit(robot, self.limit_scale),
-                            self.torque_rate, SphereCollision(self.dynamics, problem, self.margin_symbol)]
-        v, a = ca.SX.sym("qd", robot.n), ca.SX.sym("qdd", robot.n)
-        self._friction = ca.Function("friction", [v], [self.dynamics.friction(v)])
-        self._friction_rate = ca.Function("friction_rate", [v, a], [ca.jtimes(self.dynamics.friction(v), v, a)])
+    def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint]) -> None:
+        self.robot, self.dynamics, self.constraints = problem.robot, dynamics, tuple(constraints)
+        self.w, self.p = Layout("w"), Layout("p")
+        self.mu, margin, limit_scale = (self.p.add(name) for name in ("mu", "margin", "limit_scale"))
+        self.contexts = [Context(dynamics, margin, limit_scale, {
+            name: self.p.add(f"{c.name}.{name}", *shape) for name, shape in c.parameter_shapes().items()})
+            for c in self.constraints]
+        self.tau_max = ca.DM(self.robot.tau_max)
+        v, a = ca.SX.sym("qd", self.robot.n), ca.SX.sym("qdd", self.robot.n)  # friction'(q̇) a by AD of the law
+        self._friction = ca.Function("friction", [v], [dynamics.friction(v)])
+        self._friction_rate = ca.Function("friction_rate", [v, a], [ca.jtimes(dynamics.friction(v), v, a)])
         self.g: list[ca.SX] = []
         self.lbg: list[np.ndarray] = []
         self.ubg: list[np.ndarray] = []
 
+    # -- variables -----------------------------------------------------------------------------------
+    def node(self, name: str) -> Node:
+        """New variables [q; q̇; q̈; u] (4n) in w under `name`."""
+        x, n = self.w.add(name, 4 * self.robot.n), self.robot.n
+        return Node(*(x[k * n:(k + 1) * n] for k in range(4)))
+
+    def name_knots(self, knots: Sequence[str], start: int, goal: int) -> None:
+        """Name the knot nodes `knots` (in the transcription's column order) as "X" (K, 4n) and "q", "qd",
+        "qdd", "u" (K, n); the [q, q̇, q̈] of knot `start` as "start" and of knot `goal` as "goal"."""
+        n, X = self.robot.n, np.stack([self.w.index(name) for name in knots])
+        self.w.name("X", X)
+        for k, part in enumerate(("q", "qd", "qdd", "u")):
+            self.w.name(part, X[:, k * n:(k + 1) * n])
+        self.w.name("start", X[start, :3 * n])
+        self.w.name("goal", X[goal, :3 * n])
+
     # -- rows ----------------------------------------------------------------------------------------
-    def add(self, expr: ca.SX, lower, upper) -> None:
-        """The rows lower ≤ expr ≤ upper (bounds broadcast to expr's length)."""
-        self.g.append(expr)
-        self.lbg.append(np.broadcast_to(lower, (expr.numel(),)))
-        self.ubg.append(np.broadcast_to(upper, (expr.numel(),)))
+    @property
+    def row_count(self) -> int:
+        """Rows added so far."""
+        return sum(len(lower) for lower in self.lbg)
+
+    def add(self, rows: Rows) -> None:
+        """The rows lower ≤ g ≤ upper (bounds broadcast to g's length)."""
+        self.g.append(rows.g)
+        self.lbg.append(np.broadcast_to(rows.lower, (rows.g.numel(),)))
+        self.ubg.append(np.broadcast_to(rows.upper, (rows.g.numel(),)))
 
     def defect(self, expr: ca.SX) -> None:
         """The rows expr = 0."""
-        self.add(expr, 0.0, 0.0)
+        self.add(Rows(expr, 0.0, 0.0))
 
-    def dynamics_defect(self, q: ca.SX, qd: ca.SX, qdd: ca.SX, u: ca.SX) -> None:
+    def dynamics_defect(self, x: Node) -> None:
         """The dynamics at one collocation point: residual(q, q̇, q̈, τ_max u) = 0."""
-        self.defect(self.dynamics.residual(q, qd, qdd, self.tau_max * u))
+        self.defect(self.dynamics.residual(x.q, x.qd, x.qdd, self.tau_max * x.u))
 
-    def point(self, q: ca.SX, qd: ca.SX, qdd: ca.SX, u: ca.SX, du_ds: ca.SX) -> PointValues:
-        """Values at one time; du_ds is du/ds, so dτ/ds = τ_max du_ds + friction'(q̇) (dt/ds) q̈."""
-        return PointValues(q, qd, qdd, self.tau_max * u + self._friction(qd),
-                           self.tau_max * du_ds + self._friction_rate(qd, self.dt_ds * qdd), self.dt_ds)
+    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> PointValues:
+        """Values at one point; du_ds is du/ds, so dτ/ds = τ_max du_ds + friction'(q̇) (dt/ds) q̈."""
+        return PointValues(x.q, x.qd, x.qdd, self.tau_max * x.u + self._friction(x.qd),
+                           self.tau_max * du_ds + self._friction_rate(x.qd, dt_ds * x.qdd), dt_ds)
 
-    def add_path(self, values: PointValues, at_knot: bool = False) -> None:
-        """Every path constraint at one point; at a knot, less those the knot's variable bounds imply."""
-        for constraint in self.constraints:
-            if not (at_knot and constraint.enforced_by_knot_bounds):
-                self.add(*constraint.evaluate(values))
+    def path(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, at_knot: bool = False) -> None:
+        """Every path constraint at one point, in the constraints' order: those not reading rates once (at a
+        knot, less those imposed as knot bounds), those reading dτ/ds once per one-sided slope du/ds in
+        `slopes` (none without slopes)."""
+        first, *others = [self.point(x, slope, dt_ds) for slope in slopes] or [
+            self.point(x, ca.SX.zeros(self.robot.n), dt_ds)]
+        for constraint, context in zip(self.constraints, self.contexts):
+            if _imposed(constraint, bool(slopes), at_knot):
+                self.add(constraint.evaluate(first, context))
+        for values in others:
+            self._rates(values)
 
-    def add_torque_rate(self, values: PointValues) -> None:
-        """The torque-rate limit alone: for a second, one-sided dτ/ds where τ has a kink (a knot)."""
-        self.add(*self.torque_rate.evaluate(values))
+    def rates(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX) -> None:
+        """The constraints reading dτ/ds at one point, once per one-sided slope du/ds in `slopes`."""
+        for slope in slopes:
+            self._rates(self.point(x, slope, dt_ds))
 
-    def nlp_fields(self, x: ca.SX, f: ca.SX, own_parameters: ca.SX, shape_key: tuple) -> dict:
-        """The NLP's fields: x, f, p = [μ, margin, limit_scale, collision parameters, own_parameters], g."""
-        collision = ca.vertcat(*[c.parameters for c in self.constraints])
-        fields = dict(x=x, p=ca.vertcat(self.mu, self.margin_symbol, self.limit_scale, collision, own_parameters),
-                      f=f, g=ca.vertcat(*self.g), lbg=np.concatenate(self.lbg), ubg=np.concatenate(self.ubg),
-                      shape_key=shape_key)
-        return self.dynamics.lift(fields)
+    def _rates(self, values: PointValues) -> None:
+        for constraint, context in zip(self.constraints, self.contexts):
+            if constraint.reads_rate:
+                self.add(constraint.evaluate(values, context))
 
-    # -- numbers for one problem ---------------------------------------------------------------------
-    def parameter_values(self, problem: Problem, refinement: Refinement, own: np.ndarray) -> np.ndarray:
-        """p for this problem (the order of `nlp_fields`), with the margin grown and capped (module docstring)."""
-        centers = sphere_centers(self.robot, np.stack([problem.start, problem.goal]))
-        ends = clearances(self.robot, problem.scene, centers)
-        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN, 0.5 * ends.smallest())
-        collision = [c.parameter_values(problem) for c in self.constraints]
-        return np.concatenate([[problem.mu, margin, refinement.limit_scale], *collision, own])
-
-    def bounds(self, problem: Problem, refinement: Refinement, knots: int, start: int, goal: int,
-               free: int) -> tuple[np.ndarray, np.ndarray]:
-        """(lbx, ubx) for x = [vec of `knots` columns [q; q̇; q̈; u], `free` unbounded variables, t_f]; column
-        `start` holds the start at rest, column `goal` the goal at rest."""
-        r, n = self.robot, self.robot.n
-        unbounded, qd_max = np.full(n, np.inf), r.qd_max * refinement.limit_scale
-        lower = np.tile(np.concatenate([r.q_lower, -qd_max, -unbounded, -unbounded])[:, None], (1, knots))
-        upper = np.tile(np.concatenate([r.q_upper, qd_max, unbounded, unbounded])[:, None], (1, knots))
-        for i, q in ((goal, problem.goal), (start, problem.start)):  # rest at both ends, eq. (10)
-            lower[: 3 * n, i] = upper[: 3 * n, i] = np.concatenate([q, np.zeros(2 * n)])
-        rest = np.full(free, np.inf)
-        lbx = np.concatenate([lower.ravel(order="F"), -rest, [problem.time.min]])
-        ubx = np.concatenate([upper.ravel(order="F"), rest, [problem.time.max]])
-        return lbx, ubx
+    # -- the result ----------------------------------------------------------------------------------
+    def nlp(self, f: ca.SX, shape_key: tuple, stages: Stages | None = None) -> NLP:
+        """The finished NLP with objective f, as the dynamics backend hands it to solvers (`Dynamics.lift`)."""
+        fields = self.dynamics.lift({"x": self.w.symbol(), "p": self.p.symbol(), "f": f, "g": ca.vertcat(*self.g)})
+        return NLP(fields["x"], fields["p"], fields["f"], fields["g"], np.concatenate(self.lbg),
+                   np.concatenate(self.ubg), self.w, self.p, shape_key, fields.get("exact_hessian", True), stages)
 
 
-def problem_shape(problem: Problem, dynamics_name: str) -> tuple:
-    """The part of a shape key every transcription shares: dynamics, robot, obstacle count, kept collision
-    terms (start, goal, time bounds, μ and the obstacles' positions are numbers, not shape)."""
-    return (dynamics_name, id(problem.robot), problem.scene.n_obstacles,
-            *(mask.tobytes() for mask in active_terms(problem)))
+def _imposed(constraint: Constraint, with_rate: bool, at_knot: bool) -> bool:
+    """Whether `path` adds `constraint` at a point (with a slope du/ds or not; at a knot or not)."""
+    if constraint.reads_rate:
+        return with_rate
+    return not (at_knot and constraint.at_knots == "bounds")
 
 
 def knot_columns(robot: Robot, samples: Samples) -> np.ndarray:
     """Rows [q, q̇, q̈, u] (m, 4n) of sampled values, u = rnea(q, q̇, q̈) / τ_max (the rigid-body torque)."""
-    data = robot.model.createData()
-    rigid = np.array([pin.rnea(robot.model, data, q, qd, qdd).copy()
-                      for q, qd, qdd in zip(samples.q, samples.qd, samples.qdd)])
+    rigid = rigid_torque(robot, samples.q, samples.qd, samples.qdd)
     return np.hstack([samples.q, samples.qd, samples.qdd, rigid / robot.tau_max])
 
 
-def joint_samples(robot: Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, u: np.ndarray,
-                  du_dt: np.ndarray) -> Samples:
-    """Samples from interpolated [q, q̇, q̈, u] and du/dt: τ = τ_max u + friction(q̇), τ̇ = τ_max u̇ + friction'(q̇) q̈
-    (the torque the plan commands; verify compares it with rnea(q, q̇, q̈) + friction(q̇))."""
-    return Samples(np.asarray(t, dtype=float), q, qd, qdd, robot.tau_max * u + robot.friction(qd),
-                   robot.tau_max * du_dt + robot.friction_slope(qd) * qdd)
+def joint_samples(robot: Robot, t: np.ndarray, x: Node, du_dt: np.ndarray) -> Samples:
+    """Samples from interpolated [q, q̇, q̈, u] rows and du/dt: τ = τ_max u + friction(q̇), τ̇ = τ_max u̇ +
+    friction'(q̇) q̈ (the torque the plan commands; verify compares it with rnea(q, q̇, q̈) + friction(q̇))."""
+    return Samples(np.asarray(t, dtype=float), x.q, x.qd, x.qdd, robot.tau_max * x.u + robot.friction(x.qd),
+                   robot.tau_max * du_dt + robot.friction_slope(x.qd) * x.qdd)
 
 
 def straight_line(problem: Problem) -> Trajectory:

@@ -1,84 +1,112 @@
-"""The Transcription interface and the NLP it produces.
+"""The Transcription interface and the Discretization it builds.
 
-A transcription turns a Problem (through a Dynamics backend and the path constraints) into an NLP
-
-    minimize f(w; p)  subject to  lbg ≤ g(w; p) ≤ ubg,  lbx ≤ w ≤ ubx,
-
-built once per problem *shape*: start, goal, time bounds and μ enter through lbx/ubx and the
-parameter vector p, so many queries of the same shape share one NLP (and one compiled solver).
+A transcription turns a Problem, a Dynamics backend and a list of Constraint plug-ins into a `Discretization`:
+the `NLP` value the solvers get (ocpkit.nlp) plus the maps between a problem of that shape and the NLP's
+numbers. It is built once per problem *shape*: start, goal, time bounds, μ and the obstacles' positions enter
+through the variable bounds and the parameter vector, so many queries of the same shape share one NLP (and
+one prepared solver). The equations of every transcription are in docs/transcription.md.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 
-import casadi as ca
 import numpy as np
 
+from ocpkit.constraints import Constraint
+from ocpkit.constraints.collision import MAX_MARGIN
+from ocpkit.dynamics import Dynamics
+from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.nlp import NLP, Refinement
 from ocpkit.problem import Problem
 from ocpkit.registry import Registry
 from ocpkit.trajectory import Trajectory
+from ocpkit.transcription.assembly import straight_line
 
 
-@dataclass(frozen=True)
-class Refinement:
-    """What a refinement round may change without a rebuild: where the adaptive check slots sit (fractions
-    of t_f, newest first), how much the clearance margin grows (m), and the fraction of the velocity, torque
-    and torque-rate limits the NLP may use."""
+class Discretization(ABC):
+    """An NLP built for problems of one shape, with the maps from such a problem to bounds, parameters and a
+    guess, and from a solution back to a Trajectory. Parts of the NLP's vectors are read by name:
 
-    check_fractions: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    extra_margin: float = 0.0
-    limit_scale: float = 1.0
+      variables   "q", "qd", "qdd", "u": (knots, n) at every knot;  "start", "goal": [q, q̇, q̈] (3n,) at the
+                  start and goal knots;  "tf": every copy of t_f
+      parameters  "mu", "margin", "limit_scale", "<constraint>.<name>" per constraint, then the transcription's
+                  own (`own_parameters`)
 
+    `margin` (m) is the default clearance margin."""
 
-@dataclass
-class NLP(ABC):
-    """Symbolic NLP (x: decision column, p: parameter column, f: objective, g: constraints) and the
-    rules that map a Problem of its shape onto numbers and a solution back onto a Trajectory."""
+    def __init__(self, nlp: NLP, constraints: Sequence[Constraint], margin: float) -> None:
+        self.nlp, self.constraints, self.margin = nlp, tuple(constraints), margin
 
-    x: ca.SX
-    p: ca.SX
-    f: ca.SX
-    g: ca.SX
-    lbg: np.ndarray
-    ubg: np.ndarray
-    shape_key: tuple
-    exact_hessian: bool = True  # False: a dynamics backend (e.g. a callback) gives no second derivatives
-
-    @abstractmethod
     def bounds(self, problem: Problem, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
-        """(lbx, ubx) for this problem: limits, boundary conditions, time bounds."""
+        """(lbx, ubx): the knot bounds of the constraints imposed that way, start and goal at rest (eq. (10)),
+        the time bounds; everything else free."""
+        w = self.nlp.variables
+        lbx, ubx = np.full(w.size, -np.inf), np.full(w.size, np.inf)
+        for constraint in self.constraints:
+            for name, (lower, upper) in constraint.variable_bounds(refinement.limit_scale).items():
+                w.write(lbx, name, lower)
+                w.write(ubx, name, upper)
+        rest = np.zeros(2 * problem.robot.n)
+        for name, q in (("start", problem.start), ("goal", problem.goal)):
+            w.write(lbx, name, np.concatenate([q, rest]))
+            w.write(ubx, name, np.concatenate([q, rest]))
+        w.write(lbx, "tf", problem.time.min)
+        w.write(ubx, "tf", problem.time.max)
+        return lbx, ubx
 
-    @abstractmethod
     def parameters(self, problem: Problem, refinement: Refinement = Refinement()) -> np.ndarray:
-        """The parameter vector p for this problem, after `refinement` (ignored where not supported)."""
+        """p for this problem after `refinement`. The clearance margin (grown by the refinement) is capped at
+        MAX_MARGIN and at half the start's and goal's clearance, both fixed: a larger margin would make the NLP
+        infeasible."""
+        p = self.nlp.parameters
+        values = np.zeros(p.size)
+        ends = clearances(problem.robot, problem.scene, sphere_centers(problem.robot, np.stack([problem.start,
+                                                                                               problem.goal])))
+        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN, 0.5 * ends.smallest())
+        shared = {"mu": problem.mu, "margin": margin, "limit_scale": refinement.limit_scale}
+        owned = {f"{c.name}.{name}": value for c in self.constraints for name, value in
+                 c.parameter_values(problem).items()}
+        for name, value in {**shared, **owned, **self.own_parameters(refinement)}.items():
+            p.write(values, name, value)
+        return values
 
-    @abstractmethod
     def initial_guess(self, problem: Problem) -> np.ndarray:
-        """The default starting point w0."""
+        """The paper's guess: the straight joint-space line over t_f = time.guess (`assembly.straight_line`)."""
+        return self.encode(straight_line(problem))
 
     @abstractmethod
-    def decode(self, w: np.ndarray) -> Trajectory:
-        """The trajectory that the decision vector w represents."""
+    def own_parameters(self, refinement: Refinement) -> dict[str, np.ndarray]:
+        """Name → value of the transcription's own parameters (e.g. where the adaptive checks sit)."""
 
     @abstractmethod
     def encode(self, trajectory: Trajectory) -> np.ndarray:
         """A decision vector w that samples `trajectory` (any planner's) on this NLP's grid: a warm start."""
 
+    @abstractmethod
+    def decode(self, w: np.ndarray) -> Trajectory:
+        """The trajectory that the decision vector w represents."""
+
 
 class Transcription(ABC):
-    """Builds an NLP from a problem; `shape_key` says which problems share a build."""
+    """A transcription method with its options (knots, ...); `build` makes its Discretization for a problem."""
 
     name: str
 
     @abstractmethod
-    def shape_key(self, problem: Problem, dynamics_name: str) -> tuple:
-        """Hashable key: two problems with equal keys can share one NLP."""
+    def options_key(self) -> tuple:
+        """Hashable: the options that shape the NLP."""
+
+    def shape_key(self, dynamics: Dynamics, constraints: Sequence[Constraint]) -> tuple:
+        """Hashable, equal for problems that can share one build: the options, the dynamics backend (its robot
+        included), each constraint's class and shape. Start, goal, time bounds, μ and obstacle positions are
+        numbers."""
+        return self.options_key(), dynamics.key, tuple((type(c), c.shape()) for c in constraints)
 
     @abstractmethod
-    def build(self, problem: Problem, dynamics_name: str) -> NLP:
-        """The NLP for problems of this problem's shape."""
+    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint]) -> Discretization:
+        """The Discretization for problems of this problem's shape."""
 
 
-TRANSCRIPTIONS: Registry[type] = Registry("transcription", "ocpkit.transcriptions")
+TRANSCRIPTIONS: Registry[type[Transcription]] = Registry("transcription", "ocpkit.transcriptions")

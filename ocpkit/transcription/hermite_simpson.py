@@ -1,35 +1,13 @@
-"""Hermite–Simpson collocation, separated form, as in Kelly, *An Introduction to Trajectory Optimization*,
-SIAM Review 59 (2017), §4.
+"""Hermite–Simpson collocation (`hermite-simpson`), separated form, as in Kelly, *An Introduction to Trajectory
+Optimization*, SIAM Review 59 (2017), §4: a method for mesh.py.
 
-Separated, not compressed: every interval midpoint carries its own variables x_m = [q, q̇, q̈, u]_m, tied to
-the knots by the Hermite interpolation defect. That doubles the collocation points but keeps every row
-small and local (the compressed form substitutes x_m, which nests the knots' dynamics inside the midpoint's
-and makes the Hessian blocks denser).
+    x_{k+1} − x_k = (h/6)(f_k + 4 f_m + f_{k+1}),   x_m = (x_k + x_{k+1})/2 + (h/8)(f_k − f_{k+1})
 
-State x = [q, q̇], f = [q̇, q̈]; on every interval [t_k, t_k + h] (h = t_f/N, σ = (t − t_k)/h):
+Separated: every interval midpoint has its own variables [q, q̇, q̈, u]_m (why not the compressed form: see
+the doc). Interpolant: the states a cubic Hermite (`hermite`), q̈ and u the quadratic through knot, midpoint,
+knot (`quadratic`); the default check of each interval is its midpoint.
 
-    interpolation  x_m = (x_k + x_k+1)/2 + (h/8)(f_k − f_k+1)
-    collocation    x_k+1 − x_k = (h/6)(f_k + 4 f_m + f_k+1)              (Simpson's rule)
-    dynamics       residual(q, q̇, q̈, τ_max u) = 0 at every knot and midpoint
-    controls       u(σ): the quadratic through u_k, u_m, u_k+1
-    states         x(σ): the cubic Hermite through x_k, x_k+1 with slopes h f_k, h f_k+1
-    acceleration   q̈(σ): the quadratic through q̈_k, q̈_m, q̈_k+1
-    torque rate    dτ/dσ = τ_max du/dσ + friction'(q̇) h q̈,  du/dσ = u_k (4σ − 3) + u_m (4 − 8σ) + u_k+1 (4σ − 1)
-    jerk           q⃛ = (dq̈/dσ)/h, linear in σ: (−3q̈_k + 4q̈_m − q̈_k+1)/h at σ = 0, (q̈_k+1 − q̈_k)/h at ½,
-                   (q̈_k − 4q̈_m + 3q̈_k+1)/h at 1
-    cost           t_f + μ Σ_k (h/6)(q⃛_0ᵀQq⃛_0 + 4 q⃛_½ᵀQq⃛_½ + q⃛_1ᵀQq⃛_1): Simpson, exact for the quadratic q⃛ᵀQq⃛
-
-What is exact, at any point satisfying the constraints: the cubic x(σ) passes through x_k and x_k+1 by
-construction and through x_m by the interpolation defect, and its derivative is the quadratic through f_k,
-f_m, f_k+1 (Simpson's defect fixes the one slope the Hermite cubic leaves free), which is Kelly's
-interpolant. Hence d q̇/dt = q̈ exactly (q̈'s quadratic *is* the derivative of q̇'s cubic), while d q/dt is the
-quadratic through the three velocities and equals the cubic q̇ at σ = 0, ½, 1 only (an O(h³) gap). q̈ and u
-pass through their knot and midpoint values; the dynamics hold at knots and midpoints, O(h³)-close between.
-The method is exact (all equality rows vanish) for motions with q cubic in t.
-
-Path constraints sit at the knots and at one check per interval whose default is the midpoint (there its
-values equal the midpoint variables: path constraints at knots and midpoints); a refinement may move it
-(mesh.py).
+Equations: docs/transcription.md, section "Mesh methods", "Hermite–Simpson collocation".
 """
 
 from __future__ import annotations
@@ -38,8 +16,8 @@ from typing import Any
 
 import casadi as ca
 
-from ocpkit.transcription.assembly import Assembly
-from ocpkit.transcription.mesh import Local, MeshNLP, MeshTranscription, Node
+from ocpkit.transcription.assembly import Assembly, Node
+from ocpkit.transcription.mesh import Local, MeshDiscretization, MeshTranscription
 
 
 def hermite(x0: Any, x1: Any, f0: Any, f1: Any, h: Any, s: Any) -> Any:
@@ -58,7 +36,7 @@ def quadratic_slope(v0: Any, vm: Any, v1: Any, s: Any) -> Any:
     return (4 * s - 3) * v0 + (4 - 8 * s) * vm + (4 * s - 1) * v1
 
 
-class HermiteSimpsonNLP(MeshNLP):
+class HermiteSimpsonDiscretization(MeshDiscretization):
     """Separated Hermite–Simpson collocation on N intervals (module docstring); midpoint variables."""
 
     midpoints = True
@@ -87,6 +65,6 @@ class HermiteSimpson(MeshTranscription):
     N midpoints."""
 
     name = "hermite-simpson"
-    nlp = HermiteSimpsonNLP
+    discretization = HermiteSimpsonDiscretization
 
 

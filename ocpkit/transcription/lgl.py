@@ -1,34 +1,19 @@
-"""Legendre–Gauss–Lobatto (LGL) pseudospectral transcription: chebyshev.py with other points and weights.
+"""Legendre–Gauss–Lobatto (LGL) pseudospectral transcription (`lgl`): a node family for pseudospectral.py.
 
-For N intervals the N + 1 LGL points are the roots of (1 − s²) P'_N(s) (P_N the Legendre polynomial), ordered
-s_0 = 1 > … > s_N = −1 like the Chebyshev knots. On them:
+    D X = h F at the N + 1 roots of (1 − s²) P'_N(s)
 
-    quadrature        w_i = 2 / (N (N+1) P_N(s_i)²)         exact for polynomials of degree ≤ 2N − 1
-    barycentric       λ_i = 1 / P_N(s_i)                     (the node polynomial's ℓ'(s_i) ∝ P_N(s_i), by
-                                                              Legendre's equation at the roots of P'_N)
-    differentiation   D_ij = P_N(s_i) / (P_N(s_j) (s_i − s_j)),  D_00 = N(N+1)/4 = −D_NN, else D_ii = 0
+This module computes the points (Newton's iteration from the Chebyshev–Lobatto points), the barycentric
+weights 1/P_N(s_i) and the quadrature weights, exact to degree 2N − 1; everything else is pseudospectral.py's.
 
-The NLP (dynamics D X = (t_f/2) F, jerk, cost with these weights, checks, segments) is pseudospectral.py's.
-Compared with Chebyshev's Clenshaw–Curtis weights (exact to degree N) the LGL quadrature of the jerk cost is
-exact to degree 2N − 1, which covers the squared jerk of the degree-N interpolant. References: Canuto et al.,
-*Spectral Methods* (2006), §2.2; Fahroo & Ross, *Costate estimation by a Legendre pseudospectral method*,
-JGCD 24 (2001).
+Equations: docs/transcription.md, section "Pseudospectral" (family "Legendre–Gauss–Lobatto").
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ocpkit.transcription.polynomials import NodeFamily
+from ocpkit.transcription.polynomials import NodeFamily, legendre
 from ocpkit.transcription.pseudospectral import Pseudospectral
-
-
-def legendre(n: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(P_n(s), P_{n−1}(s)) by the three-term recurrence k P_k = (2k − 1) s P_{k−1} − (k − 1) P_{k−2}."""
-    previous, current = np.ones_like(s), s.copy()
-    for k in range(2, n + 1):
-        previous, current = current, ((2 * k - 1) * s * current - (k - 1) * previous) / k
-    return current, previous
 
 
 def lgl_points(n: int) -> np.ndarray:

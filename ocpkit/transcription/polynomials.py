@@ -1,9 +1,11 @@
 """Chebyshev–Lobatto polynomial tools on the normalized interval s ∈ [-1, 1], and the barycentric formulas
-every node family (`NodeFamily`: Chebyshev here, Legendre–Gauss–Lobatto in lgl.py) shares.
+every node family (`NodeFamily`: Chebyshev here, Legendre–Gauss–Lobatto in lgl.py, Legendre–Gauss–Radau in
+lgr.py) shares, and the Legendre recurrence of the last two.
 
 Knot i sits at s_i = cos(iπ/N), i = 0..N, so knot 0 is s = 1 (t = t_f) and knot N is s = -1 (t = 0),
 with t = t_f (s + 1) / 2. References: Trefethen, *Spectral Methods in MATLAB* (cheb, clencurt) and
-Berrut & Trefethen, *Barycentric Lagrange Interpolation*, SIAM Review 46 (2004).
+Berrut & Trefethen, *Barycentric Lagrange Interpolation*, SIAM Review 46 (2004). Equations:
+docs/transcription.md, section "Pseudospectral".
 """
 
 from __future__ import annotations
@@ -36,15 +38,30 @@ def barycentric_interpolation(nodes: np.ndarray, weights: np.ndarray, s: np.ndar
     return matrix
 
 
+def legendre(n: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(P_n(s), P_{n−1}(s)) by the three-term recurrence k P_k = (2k − 1) s P_{k−1} − (k − 1) P_{k−2}."""
+    previous, current = np.ones_like(s), s.copy()
+    for k in range(2, n + 1):
+        previous, current = current, ((2 * k - 1) * s * current - (k - 1) * previous) / k
+    return current, previous
+
+
 @dataclass(frozen=True)
 class NodeFamily:
     """A pseudospectral node family: for n intervals, the n + 1 points s_i (decreasing from 1 to -1, both ends
-    included), their barycentric weights and their quadrature weights (Σ w_i f(s_i) ≈ ∫_{-1}^{1} f ds)."""
+    included), their barycentric weights, their quadrature weights (Σ w_i f(s_i) ≈ ∫_{-1}^{1} f ds) and the
+    points where the differential equations are collocated (`collocated`, a bool mask (n+1,); every point
+    when None, as for the Lobatto families)."""
 
     name: str
     points: Callable[[int], np.ndarray]
     barycentric_weights: Callable[[int], np.ndarray]
     quadrature_weights: Callable[[int], np.ndarray]
+    collocated: Callable[[int], np.ndarray] | None = None
+
+    def collocation_mask(self, n: int) -> np.ndarray:
+        """Bool (n+1,): where D X = h F is imposed."""
+        return np.ones(n + 1, dtype=bool) if self.collocated is None else self.collocated(n)
 
     def differentiation(self, n: int) -> np.ndarray:
         """D, shape (n+1, n+1): exact derivative at the points of the degree-n interpolant."""

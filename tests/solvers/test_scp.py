@@ -3,56 +3,29 @@ curvature, multipliers, QP solver failures and (slow) a paper case against IPOPT
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import casadi as ca
 import numpy as np
 import pytest
 from helpers import REPO
-from test_solvers import optimum, rosenbrock_disk
+from toy_nlps import BOUNDS, GUESS, PARAMS, decision_vector, optimum, rosenbrock_disk, toy_nlp
 
 import ocpkit
+from ocpkit.nlp import NLP
 from ocpkit.solvers import scp
 from ocpkit.solvers.base import SolverStatus
 from ocpkit.solvers.casadi_nlpsol import Ipopt
 from ocpkit.solvers.scp import SequentialConvex
-from ocpkit.transcription.base import NLP
-
-
-@dataclass
-class Expressions(NLP):
-    """An NLP given by its expressions alone: the tests pass guess, parameters and bounds to `solve`."""
-
-    def bounds(self, problem=None, refinement=None):
-        raise NotImplementedError
-
-    def parameters(self, problem=None, refinement=None):
-        return np.zeros(0)
-
-    def initial_guess(self, problem=None):
-        raise NotImplementedError
-
-    def decode(self, w):
-        raise NotImplementedError
-
-    def encode(self, trajectory):
-        raise NotImplementedError
-
-
-def expressions(w: ca.SX, f: ca.SX, g: ca.SX, lbg: list, ubg: list, key: str) -> Expressions:
-    """The NLP min f(w) s.t. lbg ≤ g(w) ≤ ubg, without parameters."""
-    return Expressions(w, ca.SX.sym("p", 0), f, g, np.array(lbg, dtype=float), np.array(ubg, dtype=float), (key,))
 
 
 def solve(nlp: NLP, guess: list, lbx: list, ubx: list, **options):
+    """SequentialConvex(**options) on `nlp` (without parameters) from `guess` within lbx ≤ w ≤ ubx."""
     bounds = (np.array(lbx, dtype=float), np.array(ubx, dtype=float))
-    return SequentialConvex(**options).solve(nlp, np.array(guess, dtype=float), nlp.parameters(), bounds)
+    return SequentialConvex(**options).solve(nlp, np.array(guess, dtype=float), np.zeros(0), bounds)
 
 
 def test_disjoint_constraints_are_infeasible():
-    w = ca.SX.sym("w", 2)  # the unit disk and the half-plane w0 + w1 ≥ 3 do not meet
-    nlp = expressions(w, ca.sumsqr(w), ca.vertcat(ca.sumsqr(w), w[0] + w[1]), [-np.inf, 3.0], [1.0, np.inf],
-                      "disjoint")
+    variables, w = decision_vector(2)  # the unit disk and the half-plane w0 + w1 ≥ 3 do not meet
+    nlp = toy_nlp(variables, ca.sumsqr(w), ca.vertcat(ca.sumsqr(w), w[0] + w[1]), [-np.inf, 3.0], [1.0, np.inf])
     result = solve(nlp, [0.5, 0.5], [-5, -5], [5, 5])
     assert result.status == SolverStatus.INFEASIBLE, result.message
     assert result.stats["penalty"] == 1e4
@@ -62,8 +35,8 @@ def test_every_evaluated_point_lies_inside_the_bounds(monkeypatch):
     evaluated = []
     evaluate = scp._Evaluator.__call__
     monkeypatch.setattr(scp._Evaluator, "__call__", lambda self, w: evaluated.append(w) or evaluate(self, w))
-    w = ca.SX.sym("w", 2)  # pushed far beyond the box [0, 1]²; the constraint is slack at the corner (1, 1)
-    nlp = expressions(w, -10 * w[0] - 10 * w[1] + ca.sumsqr(w), w[0] ** 2 + w[1], [-np.inf], [3.0], "corner")
+    variables, w = decision_vector(2)  # pushed far beyond the box [0, 1]²; the constraint is slack at (1, 1)
+    nlp = toy_nlp(variables, -10 * w[0] - 10 * w[1] + ca.sumsqr(w), w[0] ** 2 + w[1], [-np.inf], [3.0])
     result = solve(nlp, [0.2, 0.9], [0, 0], [1, 1], trust_radius=50.0)
     assert result.status == SolverStatus.CONVERGED, result.message
     np.testing.assert_allclose(result.w, [1.0, 1.0], atol=1e-9)
@@ -71,8 +44,8 @@ def test_every_evaluated_point_lies_inside_the_bounds(monkeypatch):
 
 
 def test_a_convex_qp_takes_few_subproblems():
-    w = ca.SX.sym("w", 3)  # the projection of (2, 1, 0) onto the half-space w0 + w1 + w2 ≤ 1; multiplier 4/3
-    nlp = expressions(w, ca.sumsqr(w - ca.DM([2.0, 1.0, 0.0])), ca.sum1(w), [-np.inf], [1.0], "projection")
+    variables, w = decision_vector(3)  # the projection of (2, 1, 0) onto the half-space Σw ≤ 1; multiplier 4/3
+    nlp = toy_nlp(variables, ca.sumsqr(w - ca.DM([2.0, 1.0, 0.0])), ca.sum1(w), [-np.inf], [1.0])
     result = solve(nlp, [0, 0, 0], [-10] * 3, [10] * 3, trust_radius=10.0, penalty=10.0)
     assert result.status == SolverStatus.CONVERGED, result.message
     np.testing.assert_allclose(result.w, [4 / 3, 1 / 3, -2 / 3], atol=1e-6)
@@ -80,30 +53,26 @@ def test_a_convex_qp_takes_few_subproblems():
 
 
 def test_damped_bfgs_without_an_exact_hessian():
-    nlp = rosenbrock_disk(exact_hessian=False)
-    result = SequentialConvex().solve(nlp, nlp.initial_guess(), nlp.parameters(), nlp.bounds())
+    result = SequentialConvex().solve(rosenbrock_disk(exact_hessian=False), GUESS, PARAMS, BOUNDS)
     assert result.status == SolverStatus.CONVERGED, result.message
     np.testing.assert_allclose(result.w, optimum(), atol=1e-4)
 
 
 def test_multipliers_match_ipopt():
     nlp = rosenbrock_disk()
-    args = (nlp, nlp.initial_guess(), nlp.parameters(), nlp.bounds())
-    ours, theirs = SequentialConvex(tol=1e-8).solve(*args), Ipopt(tol=1e-10).solve(*args)
+    ours = SequentialConvex(tol=1e-8).prepare(nlp).solve(GUESS, PARAMS, BOUNDS)
+    theirs = Ipopt(tol=1e-10).prepare(nlp).solve(GUESS, PARAMS, BOUNDS)
     assert ours.status == SolverStatus.CONVERGED, ours.message
     np.testing.assert_allclose(ours.lam_g, theirs.lam_g, rtol=1e-3)
 
 
 def test_a_qp_solver_failure_is_a_failed_status():
-    nlp = rosenbrock_disk()
-    result = SequentialConvex(qp_solver="OSQP", max_iter=1).solve(nlp, nlp.initial_guess(), nlp.parameters(),
-                                                                   nlp.bounds())
+    result = SequentialConvex(qp_solver="OSQP", max_iter=1).solve(rosenbrock_disk(), GUESS, PARAMS, BOUNDS)
     assert result.status == SolverStatus.FAILED and "OSQP" in result.message
 
 
 def test_an_evaluation_error_is_a_failed_status():
-    nlp = rosenbrock_disk()
-    result = SequentialConvex().solve(nlp, np.zeros(5), nlp.parameters(), nlp.bounds())  # a guess too long
+    result = SequentialConvex().solve(rosenbrock_disk(), np.zeros(5), PARAMS, BOUNDS)  # a guess too long
     assert result.status == SolverStatus.FAILED and "ValueError" in result.message
 
 

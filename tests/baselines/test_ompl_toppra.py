@@ -8,14 +8,13 @@ import time
 
 import numpy as np
 import pytest
-from helpers import REPO
+from helpers import REPO, discretize
 
 import ocpkit
 import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
 from ocpkit.baselines.ompl_toppra import FreeSpace, _space_information, _state, ompl_guess, plan_ompl_toppra
-from ocpkit.errors import RegistryError, ScenarioError
+from ocpkit.errors import OptionError, RegistryError, ScenarioError
 from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.transcription.base import TRANSCRIPTIONS
 from ocpkit.verify import GEOMETRY_TOLERANCE
 
 
@@ -72,7 +71,7 @@ def test_a_goal_in_collision_fails_fast_naming_the_contact(case1, configurations
     goal = configurations[~verifier_says_free(case1, configurations)][0]
     began = time.perf_counter()
     with pytest.raises(ScenarioError, match=r"goal configuration is in collision: .*sphere \d+ \(link_"):
-        plan_ompl_toppra(dataclasses.replace(case1, goal=goal), planning_time=30.0)
+        ocpkit.plan(dataclasses.replace(case1, goal=goal), planner="ompl-toppra", planning_time=30.0)
     assert time.perf_counter() - began < 2.0  # no planner ran into its budget
 
 
@@ -80,7 +79,7 @@ def test_a_start_outside_the_limits_names_the_joint(case1):
     start = case1.start.copy()
     start[2] = case1.robot.q_upper[2] + 0.1
     with pytest.raises(ScenarioError, match=r"start: joint 3 \(joint_3\)"):
-        plan_ompl_toppra(dataclasses.replace(case1, start=start))
+        ocpkit.plan(dataclasses.replace(case1, start=start), planner="ompl-toppra")
 
 
 def test_no_path_within_the_budget_is_a_status_and_the_robot_holds_still(case1):
@@ -100,9 +99,14 @@ def test_seeded_runs_repeat_exactly(case1):
     assert other.trajectory.tf != first.trajectory.tf  # the seed is what fixes the path
 
 
+def test_options_of_other_planners_are_refused_naming_the_baselines_own(case1):
+    with pytest.raises(OptionError, match="'knots'.*planner_name, planning_time"):
+        ocpkit.plan(case1, planner="ompl-toppra", knots=12)
+
+
 @pytest.mark.slow
 def test_case1_is_planned_from_rest_to_rest_and_only_the_torque_rate_fails(case1):
-    plan = ocpkit.plan(case1, planner="ompl-toppra", knots=12, solver="ipopt")  # options of other planners ignored
+    plan = ocpkit.plan(case1, planner="ompl-toppra")
     samples = plan.trajectory.sample()
     np.testing.assert_allclose(samples.q[[0, -1]], [case1.start, case1.goal], atol=1e-9)
     np.testing.assert_allclose(samples.qd[[0, -1]], 0.0, atol=1e-9)
@@ -111,8 +115,7 @@ def test_case1_is_planned_from_rest_to_rest_and_only_the_torque_rate_fails(case1
     assert failed <= {"torque_rate"}  # TOPP-RA cannot bound it; everything else holds
     assert plan.status == ("verified" if not failed else "violated")
     assert case1.velocity_lower_bound() < plan.trajectory.tf < 2.0
-    assert plan.method == {"planner": "ompl-toppra", "transcription": "toppra", "knots": 1000,
-                           "dynamics": "pinocchio", "solver": "rrtconnect"}
+    assert plan.method == {"planner": "ompl-toppra", "path_planner": "rrtconnect", "grid_points": 1000}
     extra = plan.stats.extra
     assert extra["validity_checks"] > 0 and extra["waypoints"] >= 2
     assert all(extra[key] > 0 for key in ("path_time_s", "simplify_time_s", "toppra_time_s"))
@@ -120,7 +123,7 @@ def test_case1_is_planned_from_rest_to_rest_and_only_the_torque_rate_fails(case1
 
 @pytest.mark.slow
 def test_ompl_guess_is_the_baseline_motion_on_the_nlp_grid(case1):
-    nlp = TRANSCRIPTIONS.get("chebyshev")(knots=6).build(case1, "casadi-rnea")
+    nlp = discretize(case1, "chebyshev", "casadi-rnea", knots=6)
     baseline = plan_ompl_toppra(case1)
     w = ompl_guess(case1, nlp)
     assert w.shape == nlp.initial_guess(case1).shape

@@ -1,7 +1,7 @@
 """Where a simultaneous plan's time goes: IPOPT's function evaluations (CasADi's SX virtual machine) against
 everything else in IPOPT (mostly MUMPS factorizing the KKT system), per knot count and dynamics form.
 
-Run from the repository root:  .venv/bin/python benchmarks/profile_solve.py [--repeats 3]
+Run from the repository root:  .venv/bin/python scripts/profile_solve.py [--repeats 3]
 Prints medians over the four paper cases and `repeats` solves each, measured in this one run.
 """
 
@@ -12,7 +12,6 @@ import statistics
 from pathlib import Path
 
 import ocpkit
-from ocpkit.planner import prepared
 
 EVALUATIONS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l")
 
@@ -21,16 +20,17 @@ def profile(problems, knots: int, dynamics: str, repeats: int) -> dict[str, floa
     """Medians over problems × repeats of: solve wall time, iterations, ms per iteration, evaluation share."""
     walls, iterations, evaluation = [], [], []
     for problem in problems:
-        nlp, solver, _ = prepared(problem, "chebyshev", dynamics, "ipopt", {"knots": knots}, {})
+        made = ocpkit.build(problem, "chebyshev", knots, dynamics)
+        d = made.discretization
         for _ in range(repeats):
-            result = solver.solve(nlp, nlp.initial_guess(problem), nlp.parameters(problem), nlp.bounds(problem))
+            result = made.solver.solve(d.initial_guess(problem), d.parameters(problem), d.bounds(problem))
             walls.append(result.wall_time)
             iterations.append(result.iterations)
             evaluation.append(sum(result.stats.get(f"t_wall_{name}", 0.0) for name in EVALUATIONS))
     return {"solve_s": statistics.median(walls), "iterations": statistics.median(iterations),
             "ms_per_iteration": 1e3 * statistics.median(w / i for w, i in zip(walls, iterations)),
             "evaluation_share": statistics.median(e / w for e, w in zip(evaluation, walls)),
-            "variables": nlp.x.numel(), "constraints": nlp.g.numel()}
+            "variables": d.nlp.x.numel(), "constraints": d.nlp.g.numel()}
 
 
 def main() -> None:

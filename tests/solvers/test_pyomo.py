@@ -3,24 +3,34 @@ a paper case planned to the same t_f as IPOPT (the generic solver tests are in t
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import casadi as ca
 import numpy as np
 import pytest
-from helpers import REPO
-from test_solvers import RosenbrockDisk, rosenbrock_disk
+from helpers import REPO, discretize
+from toy_nlps import (
+    BOUNDS,
+    DISK,
+    GUESS,
+    PARAMS,
+    decision_vector,
+    rosenbrock_disk,
+    toy_nlp,
+)
 
 import ocpkit
 from ocpkit.errors import OptionError
+from ocpkit.nlp import Layout
 from ocpkit.solvers.base import SolverStatus
 from ocpkit.solvers.casadi_nlpsol import Ipopt
 from ocpkit.solvers.pyomo_nlp import PyomoRipopt, _Dag
-from ocpkit.transcription.base import TRANSCRIPTIONS
 
 
 def test_constraint_multipliers_match_ipopt_in_sign_and_size():
     nlp = rosenbrock_disk()
-    args = (nlp, nlp.initial_guess(), nlp.parameters(), nlp.bounds())
-    reference, result = Ipopt(tol=1e-10).solve(*args), PyomoRipopt(tol=1e-10).solve(*args)
+    reference = Ipopt(tol=1e-10).prepare(nlp).solve(GUESS, PARAMS, BOUNDS)
+    result = PyomoRipopt(tol=1e-10).prepare(nlp).solve(GUESS, PARAMS, BOUNDS)
     assert result.status == SolverStatus.CONVERGED, result.message
     assert reference.lam_g[0] > 0  # the active upper bound of the disk
     np.testing.assert_allclose(result.lam_g, reference.lam_g, rtol=1e-6)
@@ -37,28 +47,37 @@ def test_shared_nodes_are_lifted_above_the_tree_size_and_named_below():
 
 @pytest.mark.parametrize("lift_above", [0.0, np.inf])
 def test_lifting_shared_subexpressions_leaves_the_solution(lift_above):
-    w, p = ca.SX.sym("w", 3), ca.SX.sym("p", 2)
+    variables, w = decision_vector(3)
+    parameters = Layout("p")
+    p = parameters.add("p", 2)
     shared = w[0] ** 2  # used by f and g: lifted to a variable with lift_above 0, a named expression with ∞
     f = (p[0] - w[0]) ** 2 + 100 * (w[1] - shared) ** 2 + (w[2] - 1) ** 2
     g = ca.vertcat(shared + w[1] ** 2, w[0] + w[1] - p[1])
-    nlp = RosenbrockDisk(w, p, f, g, np.array([-np.inf, 0.0]), np.array([1.532, 0.0]), ("shared",))
-    args = (nlp, nlp.initial_guess(), nlp.parameters(), nlp.bounds())
-    result, reference = PyomoRipopt(lift_above=lift_above).solve(*args), Ipopt().solve(*args)
+    nlp = toy_nlp(variables, f, g, [-np.inf, 0.0], [DISK, 0.0], parameters)
+    result = PyomoRipopt(lift_above=lift_above).solve(nlp, GUESS, PARAMS, BOUNDS)
+    reference = Ipopt().solve(nlp, GUESS, PARAMS, BOUNDS)
     assert result.status == SolverStatus.CONVERGED, result.message
     np.testing.assert_allclose(result.w, reference.w, atol=1e-6)
+
+
+def test_an_mx_nlp_is_refused():
+    nlp = replace(rosenbrock_disk(), x=ca.MX.sym("w", 3))  # as from a dynamics backend evaluated by a callback
+    with pytest.raises(OptionError, match="evaluates through a callback"):
+        PyomoRipopt().prepare(nlp)
 
 
 @pytest.mark.parametrize("dynamics", ["pinocchio", "pinocchio-rnea"])
 def test_an_nlp_around_a_callback_is_refused(dynamics):
     problem = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
-    nlp = TRANSCRIPTIONS.get("chebyshev")(knots=2).build(problem, dynamics)
-    with pytest.raises(OptionError, match=f"dynamics backend '{dynamics}' evaluates through a callback"):
+    nlp = discretize(problem, "chebyshev", dynamics, knots=2).nlp
+    assert isinstance(nlp.x, ca.MX) and not nlp.exact_hessian
+    with pytest.raises(OptionError, match="evaluates through a callback"):
         PyomoRipopt().prepare(nlp)
 
 
 def test_an_operation_without_translation_is_named():
     nlp = rosenbrock_disk()
-    nlp.f = nlp.f + ca.fmax(nlp.x[0], nlp.x[1])
+    nlp = replace(nlp, f=nlp.f + ca.fmax(nlp.x[0], nlp.x[1]))
     with pytest.raises(OptionError, match="OP_FMAX"):
         PyomoRipopt().prepare(nlp)
 

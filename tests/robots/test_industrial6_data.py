@@ -1,14 +1,14 @@
 """Consistency checks of the built-in industrial6 robot data (robot.urdf + spec.yaml)."""
 
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
+from helpers import REPO
 
-DATA = Path(__file__).parents[1] / "ocpkit/robots/data/industrial6"
+DATA = REPO / "ocpkit/robots/data/industrial6"
 URDF = DATA / "robot.urdf"
 
 # Paper Table I, in the paper's units (deg, deg/s, Nm, Nm/s).

@@ -8,7 +8,7 @@ import pytest
 
 from ocpkit.bench.convergence import COLUMNS, groups, read_rows, run_convergence
 
-TINY = {"chebyshev": (6, 10, 14), "trapezoidal": (8, 16)}
+TINY = {"chebyshev": (6, 10, 14), "lgr": (6, 10, 14), "trapezoidal": (8, 16)}
 
 
 @pytest.mark.slow
@@ -17,17 +17,18 @@ def test_tiny_sweep_writes_csv_and_plot_and_shows_the_rates(tmp_path):
 
     with (tmp_path / "convergence.csv").open(newline="") as handle:
         assert tuple(csv.DictReader(handle).fieldnames) == COLUMNS
-    assert len(read_rows(tmp_path / "convergence.csv")) == len(rows) == 5
+    assert len(read_rows(tmp_path / "convergence.csv")) == len(rows) == 8
     assert (tmp_path / "convergence.png").stat().st_size > 10_000
     assert all(r["status"] == "verified" for r in rows)
 
     by = groups(rows)
-    cheb, trap = by["smooth", "chebyshev"], by["smooth", "trapezoidal"]
-    # no bound active: the optimum is a quintic in t, which Chebyshev at N ≥ 5 represents exactly
-    assert all(r["tf_error"] < 1e-6 for r in cheb)
-    # while u interpolates rnea(q(t)) (not a polynomial): spectral decay of the dynamics residual
-    residuals = [r["dynamics_residual"] for r in cheb]
-    assert residuals[0] > 10 * residuals[1] > 100 * residuals[2]
+    cheb, lgr, trap = by["smooth", "chebyshev"], by["smooth", "lgr"], by["smooth", "trapezoidal"]
+    for pseudospectral in (cheb, lgr):
+        # no bound active: the optimum is a quintic in t, which a degree-N polynomial at N ≥ 5 represents exactly
+        assert all(r["tf_error"] < 1e-6 for r in pseudospectral)
+        # while u interpolates rnea(q(t)) (not a polynomial): spectral decay of the dynamics residual
+        residuals = [r["dynamics_residual"] for r in pseudospectral]
+        assert residuals[0] > 10 * residuals[1] > 100 * residuals[2]
     # trapezoidal is second order: halving h quarters the t_f error
     assert 3.0 < trap[0]["tf_error"] / trap[1]["tf_error"] < 5.0
     assert trap[1]["tf_error"] > 100 * cheb[0]["tf_error"]

@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
+import pinocchio as pin
 import pytest
 import yaml
 from helpers import REPO, example_robot_urdf
 
 from ocpkit import load_robot
 from ocpkit.errors import RobotError
-from ocpkit.robots import builtin_robots
+from ocpkit.geometry import sphere_centers
+from ocpkit.robots import builtin_robots, rigid_torque, sphere_reach
 
 SPEC = REPO / "ocpkit/robots/data/industrial6/spec.yaml"
 
@@ -25,7 +29,23 @@ def test_builtin_industrial6():
     assert "industrial6" in builtin_robots()
     assert robot.n == 6 and robot.model.nq == 6
     assert robot.sphere_radius.shape == (len(robot.sphere_link),)
-    assert load_robot("industrial6") is robot  # cached: problems on one robot share one NLP shape
+    assert load_robot("industrial6") is robot  # cached by content: problems on one robot share its builds
+    assert len(robot.key) == 64 and int(robot.key, 16) >= 0  # sha256 hex
+
+
+def test_robot_identity_follows_file_content(tmp_path):
+    for name in ("robot.urdf", "spec.yaml"):
+        shutil.copy(SPEC.parent / name, tmp_path / name)
+    files = {"urdf": "robot.urdf", "spec": "spec.yaml"}
+    first = load_robot(files, tmp_path)
+    assert load_robot(files, tmp_path) is first  # unchanged files: the same object and key
+    spec = yaml.safe_load((tmp_path / "spec.yaml").read_text())
+    spec["limits"]["velocity"][0] = 0.5
+    (tmp_path / "spec.yaml").write_text(yaml.safe_dump(spec))
+    edited = load_robot(files, tmp_path)
+    assert edited.qd_max[0] == 0.5 and first.qd_max[0] != 0.5  # the files are read again
+    assert edited.key != first.key and edited is not first
+    assert load_robot(files, tmp_path) is edited
 
 
 def test_friction_is_viscous_plus_smooth_coulomb():
@@ -36,6 +56,38 @@ def test_friction_is_viscous_plus_smooth_coulomb():
     h = 1e-7
     np.testing.assert_allclose(robot.friction_slope(qd), (robot.friction(qd + h) - robot.friction(qd - h)) / (2 * h),
                                rtol=1e-5)
+
+
+def test_rigid_torque_is_rnea_at_every_row():
+    robot = load_robot("industrial6")
+    rng = np.random.default_rng(1)
+    q, qd, qdd = rng.uniform(robot.q_lower, robot.q_upper, (5, 6)), rng.uniform(-2, 2, (5, 6)), rng.normal(size=(5, 6))
+    expected = [pin.rnea(robot.model, robot.model.createData(), *row) for row in zip(q, qd, qdd)]
+    np.testing.assert_allclose(rigid_torque(robot, q, qd, qdd), expected, atol=1e-12)
+    assert rigid_torque(robot, q[:0], qd[:0], qdd[:0]).shape == (0, 6)
+
+
+@pytest.mark.parametrize("name", ["industrial6", "panda"])
+def test_sphere_reach_bounds_every_sphere_centre(name, tmp_path):
+    robot = load_robot("industrial6") if name == "industrial6" else _panda(tmp_path)
+    anchors, reach = sphere_reach(robot)
+    assert anchors.shape == (len(reach), 3) and len(reach) == len(robot.sphere_radius)
+    q = np.random.default_rng(2).uniform(robot.q_lower, robot.q_upper, (200, robot.n))
+    distance = np.linalg.norm(sphere_centers(robot, q) - anchors, axis=-1)  # (K, M)
+    assert np.all(distance <= reach + 1e-9)
+
+
+def _panda(tmp_path):
+    """Panda with its prismatic fingers (a stroke in the reach) and a sphere on a finger and on the base."""
+    joints = [f"panda_joint{k}" for k in range(1, 8)] + ["panda_finger_joint1"]
+    spec = {"name": "panda", "joints": joints,
+            "limits": {"position": {"lower": [-2.8] * 7 + [0.0], "upper": [2.8] * 7 + [0.04]}, "velocity": [2] * 8,
+                       "torque": [80] * 8, "torque_rate": [1000] * 8},
+            "gear_ratios": [100] * 8, "friction": {"viscous": [0.1] * 8, "coulomb": [1] * 8, "smoothing": 0.05},
+            "spheres": [{"link": "panda_leftfinger", "center": [0, 0.01, 0.03], "radius": 0.02},
+                        {"link": "panda_link0", "center": [0, 0, 0.05], "radius": 0.1}]}
+    (tmp_path / "panda.yaml").write_text(yaml.safe_dump(spec))
+    return load_robot({"urdf": str(example_robot_urdf("panda")), "spec": str(tmp_path / "panda.yaml")})
 
 
 def test_custom_files_relative_to_base_dir(tmp_path):

@@ -2,21 +2,20 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import casadi as ca
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from helpers import example_robot_urdf
+from helpers import REPO, example_robot_urdf
 
 from ocpkit.dynamics.spatial import SymbolicModel
 
 TOL = 1e-8
 N_STATES = 20
 MODELS = ["ur5", "panda", "industrial6", "tree"]
-INDUSTRIAL6 = Path(__file__).resolve().parents[1] / "ocpkit/robots/data/industrial6/robot.urdf"
+INDUSTRIAL6 = REPO / "ocpkit/robots/data/industrial6/robot.urdf"
 
 
 def random_tree_model(rng: np.random.Generator) -> pin.Model:

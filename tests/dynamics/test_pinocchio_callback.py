@@ -84,24 +84,43 @@ def test_residual_vanishes_exactly_on_consistent_states(name, kind):
             assert (np.abs(r).max() < 1e-8) == vanishes
 
 
+def _nlp(dynamics, points: int) -> dict:
+    """A small SX NLP with `points` dynamics residuals, lifted by `dynamics`."""
+    x, p = ca.SX.sym("x", 4 * N * points), ca.SX.sym("p", 1)
+    cols = [x[4 * N * k:4 * N * (k + 1)] for k in range(points)]
+    g = ca.vertcat(*[dynamics.residual(c[:N], c[N:2 * N], c[2 * N:3 * N], p * c[3 * N:]) for c in cols])
+    f = ca.sumsqr(g) + p * ca.sumsqr(x)
+    return dynamics.lift(dict(x=x, p=p, f=f, g=g, lbg=None, ubg=None, shape_key=()))
+
+
+def _evaluate(fields: dict, x0: np.ndarray) -> list[np.ndarray]:
+    """f, g and dg/dx at x0, p = 30."""
+    fn = ca.Function("nlp", [fields["x"], fields["p"]],
+                     [fields["f"], fields["g"], ca.jacobian(fields["g"], fields["x"])])
+    return [np.asarray(ca.densify(v)) for v in fn(x0, 30.0)]
+
+
+def _x0(points: int) -> np.ndarray:
+    return np.concatenate([np.concatenate([COLUMNS[:, k], RNG.uniform(-1, 1, N)]) for k in range(points)])
+
+
+def _assert_same_nlp(lifted: dict, twin: dict, x0: np.ndarray) -> None:
+    for a, b in zip(_evaluate(twin, x0), _evaluate(lifted, x0)):
+        np.testing.assert_allclose(b, a, atol=1e-8 * max(1.0, np.abs(a).max()), rtol=0)
+
+
 @pytest.mark.parametrize("name", TWIN)
 def test_lift_turns_an_sx_nlp_with_placeholders_into_the_same_mx_nlp(name):
     """The SX residual records placeholders; `lift` gives an MX NLP whose f, g and Jacobian equal those of the
     same NLP built with the twin's symbolic residual."""
-    x, p = ca.SX.sym("x", 4 * N * 2), ca.SX.sym("p", 1)
-    fields = {}
-    for backend in (TWIN[name], name):
-        dynamics = make_dynamics(backend, ROBOT)
-        cols = [x[4 * N * k:4 * N * (k + 1)] for k in range(2)]
-        g = ca.vertcat(*[dynamics.residual(c[:N], c[N:2 * N], c[2 * N:3 * N], p * c[3 * N:]) for c in cols])
-        f = ca.sumsqr(g) + p * ca.sumsqr(x)
-        fields[backend] = dynamics.lift(dict(x=x, p=p, f=f, g=g, lbg=None, ubg=None, shape_key=()))
-    lifted = fields[name]
+    lifted = _nlp(make_dynamics(name, ROBOT), 2)
     assert isinstance(lifted["x"], ca.MX) and lifted["exact_hessian"] is False
-    x0 = np.concatenate([COLUMNS[:, 0], RNG.uniform(-1, 1, N), COLUMNS[:, 1], RNG.uniform(-1, 1, N)])
-    out = {}
-    for backend, fl in fields.items():
-        fn = ca.Function("nlp", [fl["x"], fl["p"]], [fl["f"], fl["g"], ca.jacobian(fl["g"], fl["x"])])
-        out[backend] = [np.asarray(ca.densify(v)) for v in fn(x0, 30.0)]
-    for a, b in zip(out[TWIN[name]], out[name]):
-        np.testing.assert_allclose(b, a, atol=1e-8 * max(1.0, np.abs(a).max()), rtol=0)
+    _assert_same_nlp(lifted, _nlp(make_dynamics(TWIN[name], ROBOT), 2), _x0(2))
+
+
+@pytest.mark.parametrize("name", TWIN)
+def test_one_instance_serves_builds_one_after_the_other(name):
+    """`lift` forgets the placeholders it lifted: a second build on the same instance lifts its own only."""
+    dynamics, twin = make_dynamics(name, ROBOT), make_dynamics(TWIN[name], ROBOT)
+    for points in (2, 3):
+        _assert_same_nlp(_nlp(dynamics, points), _nlp(twin, points), _x0(points))

@@ -1,0 +1,174 @@
+"""SphereCollision: rows against closed-form clearances on pinocchio sphere centres, and which terms are kept."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import casadi as ca
+import numpy as np
+import pytest
+from helpers import REPO
+
+import ocpkit
+from ocpkit.constraints import Context, PointValues
+from ocpkit.constraints.collision import MAX_MARGIN, SphereCollision, active_terms
+from ocpkit.dynamics import make_dynamics
+from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.scene import Scene, Workspace
+
+PROBLEM = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
+ROBOT = PROBLEM.robot
+N = ROBOT.n
+RADIUS = ROBOT.sphere_radius
+
+
+def with_scene(**changes) -> ocpkit.Problem:
+    return dataclasses.replace(PROBLEM, scene=dataclasses.replace(PROBLEM.scene, **changes))
+
+
+def evaluate(constraint: SphereCollision, problem: ocpkit.Problem, q: np.ndarray, margin: float
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(g, lower, upper) at configuration q with the problem's own parameter values, via a ca.Function."""
+    point = PointValues(*(ca.SX.sym(k, N) for k in ("q", "qd", "qdd", "tau", "dtau_ds")), ca.SX.sym("dt_ds"))
+    shapes = constraint.parameter_shapes()
+    symbols = {name: ca.SX.sym(name, *shape) for name, shape in shapes.items()}
+    margin_sx = ca.SX.sym("margin")
+    rows = constraint.evaluate(point, Context(make_dynamics("casadi", ROBOT), margin_sx, ca.SX.sym("s"), symbols))
+    function = ca.Function("rows", [point.q, margin_sx, *symbols.values()], [rows.g])
+    values = constraint.parameter_values(problem)
+    g = function(q, margin, *(np.reshape(values[name], shapes[name]) for name in symbols))
+    return np.asarray(g).ravel(), rows.lower, rows.upper
+
+
+def expected_rows(constraint: SphereCollision, problem: ocpkit.Problem, q: np.ndarray, margin: float) -> np.ndarray:
+    """Closed forms on pinocchio centres: ‖c_a − c_b‖² − (r_a + r_b + margin)² for self pairs and obstacles
+    (in mask order), then one workspace row per (sphere, axis) with a reachable face."""
+    c, scene = sphere_centers(ROBOT, q), problem.scene
+    rows = [np.sum((c[a] - c[b]) ** 2) - (RADIUS[a] + RADIUS[b] + margin) ** 2 for a, b in constraint.pairs]
+    for m in range(len(RADIUS)):
+        for s in range(scene.n_obstacles):
+            if constraint.obstacle_mask[m, s]:
+                rows.append(np.sum((c[m] - scene.obstacle_centers[s]) ** 2)
+                            - (RADIUS[m] + scene.obstacle_radii[s] + margin) ** 2)
+    faces = constraint.face_mask
+    for m in range(len(RADIUS)):
+        for axis in range(3):
+            low = scene.workspace.lower[axis] + RADIUS[m] + margin
+            high = scene.workspace.upper[axis] - RADIUS[m] - margin
+            if faces[m, axis] and faces[m, axis + 3]:
+                rows.append((c[m, axis] - low) / (high - low))
+            elif faces[m, axis]:
+                rows.append(c[m, axis] - low)
+            elif faces[m, axis + 3]:
+                rows.append(high - c[m, axis])
+    return np.array(rows)
+
+
+def test_rows_match_closed_form_clearances_at_random_configurations():
+    constraint = SphereCollision(PROBLEM)
+    rng = np.random.default_rng(3)
+    for q in rng.uniform(ROBOT.q_lower, ROBOT.q_upper, (3, N)):
+        g, lower, upper = evaluate(constraint, PROBLEM, q, margin=0.02)
+        np.testing.assert_allclose(g, expected_rows(constraint, PROBLEM, q, 0.02), rtol=1e-9, atol=1e-12)
+        assert lower.shape == upper.shape == g.shape and np.all(lower == 0)
+
+
+def test_obstacle_row_is_zero_when_the_sphere_touches_the_obstacle_with_margin():
+    q, m, margin = PROBLEM.start, 13, 0.03
+    centre = sphere_centers(ROBOT, q)[m]
+    direction = np.array([0.6, 0.0, 0.8])
+    touching = with_scene(obstacle_centers=(centre + (RADIUS[m] + 0.1 + margin) * direction)[None],
+                          obstacle_radii=np.array([0.1]))
+    constraint = SphereCollision(touching)
+    g, _, _ = evaluate(constraint, touching, q, margin)
+    row = len(constraint.pairs) + int(np.flatnonzero(constraint.obstacle_mask[:, 0]).tolist().index(m))
+    assert g[row] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_self_pair_rows_cover_every_pair_with_a_moving_sphere():
+    constraint = SphereCollision(PROBLEM)
+    assert np.all(ROBOT.sphere_joint[constraint.pairs].max(axis=1) > 0)
+    assert len(constraint.pairs) == len(ROBOT.self_collision)  # industrial6: every listed pair has one
+
+
+def test_workspace_rows_are_within_unit_interval_inside_the_box():
+    constraint = SphereCollision(PROBLEM)
+    g, _, upper = evaluate(constraint, PROBLEM, PROBLEM.start, margin=0.01)
+    both = constraint.face_mask[:, :3] & constraint.face_mask[:, 3:]
+    assert both.any()
+    n_workspace = int((constraint.face_mask[:, :3] | constraint.face_mask[:, 3:]).sum())
+    workspace, bounds = g[-n_workspace:], upper[-n_workspace:]
+    two_sided = bounds == 1.0
+    assert two_sided.sum() == both.sum()
+    assert np.all((workspace[two_sided] >= 0) & (workspace[two_sided] <= 1))
+    assert np.all(workspace[~two_sided] >= 0) and np.all(np.isinf(bounds[~two_sided]))
+
+
+def test_parameters_are_the_obstacles_and_the_box_by_name():
+    constraint = SphereCollision(PROBLEM)
+    assert constraint.parameter_shapes() == {"obstacle_center": (1, 3), "obstacle_radius": (1, 1), "workspace": (6, 1)}
+    values = constraint.parameter_values(PROBLEM)
+    np.testing.assert_array_equal(values["obstacle_center"], PROBLEM.scene.obstacle_centers)
+    np.testing.assert_array_equal(values["obstacle_radius"], PROBLEM.scene.obstacle_radii)
+    np.testing.assert_array_equal(values["workspace"], np.concatenate([PROBLEM.scene.workspace.lower,
+                                                                       PROBLEM.scene.workspace.upper]))
+
+
+def test_without_a_workspace_there_are_no_workspace_rows_or_parameters():
+    free = with_scene(workspace=None)
+    constraint = SphereCollision(free)
+    assert constraint.face_mask.shape == (len(RADIUS), 0)
+    assert constraint.parameter_shapes()["workspace"] == (0, 1)
+    g, _, _ = evaluate(constraint, free, PROBLEM.start, margin=0.0)
+    assert len(g) == len(constraint.pairs) + int(constraint.obstacle_mask.sum())
+
+
+def test_a_sphere_that_cannot_reach_an_obstacle_gets_no_row():
+    far = with_scene(obstacle_centers=np.array([[10.0, 0.0, 0.5]]), obstacle_radii=np.array([0.2]))
+    obstacles, _ = active_terms(far)
+    assert not obstacles.any()
+    g, _, _ = evaluate(SphereCollision(far), far, PROBLEM.start, margin=0.0)
+    none = with_scene(obstacle_centers=np.zeros((0, 3)), obstacle_radii=np.zeros(0))
+    assert len(g) == len(evaluate(SphereCollision(none), none, PROBLEM.start, margin=0.0)[0])
+    near = SphereCollision(PROBLEM)
+    assert len(evaluate(near, PROBLEM, PROBLEM.start, margin=0.0)[0]) == len(g) + int(near.obstacle_mask.sum())
+
+
+def test_spheres_on_the_base_never_get_an_obstacle_row():
+    at_base = with_scene(obstacle_centers=np.array([[0.0, 0.0, 0.12]]), obstacle_radii=np.array([0.3]))
+    obstacles, _ = active_terms(at_base)
+    assert not obstacles[ROBOT.sphere_joint == 0].any()
+    assert obstacles[ROBOT.sphere_joint > 0].any()
+
+
+def test_moving_an_obstacle_within_reach_changes_the_shape():
+    far = SphereCollision(with_scene(obstacle_centers=np.array([[10.0, 0.0, 0.5]])))
+    near = SphereCollision(with_scene(obstacle_centers=np.array([[1.0, 0.0, 0.5]])))
+    nudged = SphereCollision(with_scene(obstacle_centers=PROBLEM.scene.obstacle_centers + [0.0, 0.02, 0.0]))
+    assert far.shape() != near.shape()
+    assert nudged.shape() == SphereCollision(PROBLEM).shape()
+    assert hash(near.shape()) is not None
+
+
+def test_kept_terms_cover_every_contact_the_robot_can_reach():
+    """Soundness of the reach bound: any configuration's clearance below MAX_MARGIN is a kept term."""
+    problem = with_scene(obstacle_centers=np.array([[1.2, 0.1, 1.05], [0.0, 0.9, 0.4], [-0.6, -0.6, 1.6]]),
+                         obstacle_radii=np.array([0.25, 0.3, 0.2]),
+                         workspace=Workspace(np.array([-0.8, -1.2, -0.3]), np.array([1.4, 1.2, 1.8])))
+    obstacles, faces = active_terms(problem)
+    rng = np.random.default_rng(11)
+    c = clearances(ROBOT, problem.scene, sphere_centers(ROBOT, rng.uniform(ROBOT.q_lower, ROBOT.q_upper, (400, N))))
+    moving = ROBOT.sphere_joint > 0
+    close_obstacles = (c.obstacles < MAX_MARGIN).any(axis=0) & moving[:, None]
+    close_faces = (c.workspace < MAX_MARGIN).any(axis=0) & moving[:, None]
+    assert close_obstacles.any() and close_faces.any()  # the sample does reach the terms
+    assert np.all(obstacles[close_obstacles]) and np.all(faces[close_faces])
+
+
+def test_empty_scene_without_self_pairs_gives_an_empty_column():
+    scene = Scene()
+    problem = dataclasses.replace(PROBLEM, scene=scene)
+    constraint = SphereCollision(problem)
+    constraint.pairs = constraint.pairs[:0]
+    g, lower, upper = evaluate(constraint, problem, PROBLEM.start, margin=0.0)
+    assert g.shape == lower.shape == upper.shape == (0,)

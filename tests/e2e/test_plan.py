@@ -1,0 +1,137 @@
+"""End-to-end planning: the paper cases verify, shapes are reused, failures are reported as statuses, and
+the exported JSON passes an outside check that knows nothing of ocpkit."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+from helpers import REPO
+
+import ocpkit
+from ocpkit.bench.paper import run_paper_benchmark
+from ocpkit.cli import main
+from ocpkit.report import RESULT_COLUMNS, trajectory_header
+
+CASES = sorted((REPO / "scenarios/paper").glob("case*.yaml"))
+DATA = REPO / "ocpkit/robots/data/industrial6"
+pytestmark = pytest.mark.slow
+
+
+@pytest.mark.parametrize("knots", [12, 8])
+@pytest.mark.parametrize("case", CASES, ids=lambda p: p.stem)
+def test_paper_case_is_verified(case, knots):
+    problem = ocpkit.load_scenario(case)
+    result = ocpkit.plan(problem, knots=knots)
+    assert result.status == "verified", result.verification.summary()
+    assert problem.velocity_lower_bound() < result.trajectory.tf < 3.0
+
+
+def test_second_query_of_a_shape_reuses_the_build():
+    problem = ocpkit.load_scenario(CASES[1])
+    ocpkit.plan(problem, knots=8)
+    moved = dataclasses.replace(problem, scene=dataclasses.replace(
+        problem.scene, obstacle_centers=problem.scene.obstacle_centers + [0.0, 0.05, 0.0]))
+    again = ocpkit.plan(moved, knots=8)
+    assert again.stats.setup_time == 0.0
+    assert again.ok, again.verification.summary()
+
+
+def test_iteration_limit_is_a_status_not_a_success():
+    problem = ocpkit.load_scenario(CASES[0])
+    result = ocpkit.plan(problem, knots=8, solver_options={"max_iterations": 3})
+    assert result.status == "iteration_limit" and not result.ok
+
+
+def test_time_bound_below_what_the_torques_allow_is_not_verified():
+    problem = ocpkit.load_scenario(CASES[0])
+    rushed = dataclasses.replace(problem, time=ocpkit.TimeBounds(0.1, problem.velocity_lower_bound() * 1.02, 0.5))
+    result = ocpkit.plan(rushed, knots=8)
+    assert result.status in ("infeasible", "failed", "violated") and not result.ok
+
+
+def test_exported_json_passes_the_outside_check(tmp_path):
+    problem = ocpkit.load_scenario(CASES[0])
+    result = ocpkit.plan(problem, knots=12)
+    path = tmp_path / "case1.json"
+    ocpkit.write_json(path, result.trajectory, trajectory_header(problem, result))
+    document = json.loads(path.read_text())
+    assert document["format"] == "ocpkit.trajectory/1" and document["status"] == "verified"
+    assert document["samples"]["t"][1] == pytest.approx(0.001)
+    assert document["samples"]["t"][-1] == pytest.approx(document["tf"])
+    check = subprocess.run([sys.executable, str(REPO / "tests/outside_check.py"), str(path), str(DATA / "spec.yaml"),
+                            str(DATA / "robot.urdf"), str(CASES[0])], capture_output=True, text=True)
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_cli_plan_prints_status_and_writes_json(tmp_path, capsys):
+    out = tmp_path / "t.json"
+    assert main(["plan", str(CASES[2]), "--knots", "8", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "status verified" in printed and "iterations" in printed and "checks: all pass" in printed
+    assert json.loads(out.read_text())["method"]["knots"] == 8
+
+
+def test_cli_reports_user_mistakes_in_one_line(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("robot: robby\nunit: deg\nstart: [0]\ngoal: [0]\n")
+    assert main(["plan", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "unknown robot 'robby'" in err and "Traceback" not in err
+
+
+def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
+    shutil.copy(CASES[3], tmp_path / CASES[3].name)
+    run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1, dynamics=("casadi-rnea", "casadi"))
+    rows = list(csv.DictReader((tmp_path / "out/results.csv").open()))
+    assert tuple(rows[0]) == RESULT_COLUMNS
+    assert [(r["planner"], r["dynamics"], r["knots"], r["status"]) for r in rows[:4]] == [
+        ("simultaneous", "casadi-rnea", "12", "verified"), ("simultaneous", "casadi-rnea", "8", "verified"),
+        ("simultaneous", "casadi", "12", "verified"), ("simultaneous", "casadi", "8", "verified")]
+    assert rows[4]["planner"] == "ompl-toppra" and rows[4]["status"] in ("verified", "violated")
+    assert (tmp_path / "out/trajectories/case4-ompl-toppra.json").exists()
+    assert (tmp_path / "out/trajectories/case4-simultaneous-chebyshev-12.json").exists()
+    printed = capsys.readouterr().out
+    assert "motion time t_f" in printed and "paper set-up" in printed and "ratio sim / baseline" in printed
+
+
+def test_refinement_repairs_contact_between_check_times():
+    problem = ocpkit.load_scenario(CASES[1])
+    no_margin = {"margin": 0.0}
+    unrefined = ocpkit.plan(problem, knots=8, refinements=0, transcription_options=no_margin)
+    assert unrefined.status == "violated" and unrefined.verification.penetration > 0
+    refined = ocpkit.plan(problem, knots=8, transcription_options=no_margin)
+    assert refined.ok and refined.stats.rounds >= 1
+    assert refined.stats.setup_time == 0.0  # the same NLP, re-solved: refinement needs no rebuild
+
+
+def test_ompl_guess_seeds_the_simultaneous_planner():
+    problem = ocpkit.load_scenario(CASES[3])
+    seeded = ocpkit.plan(problem, knots=8, guess="ompl")
+    assert seeded.ok, seeded.verification.summary()
+    assert seeded.trajectory.tf == pytest.approx(ocpkit.plan(problem, knots=8).trajectory.tf, rel=0.02)
+
+
+def test_cli_runs_the_baseline_and_reports_what_it_violates(capsys):
+    code = main(["plan", str(CASES[2]), "--planner", "ompl-toppra"])
+    printed = capsys.readouterr().out
+    assert code == 1 and "status violated" in printed and "torque_rate" in printed
+
+
+def test_an_option_a_transcription_does_not_take_is_a_one_line_error(capsys):
+    assert main(["plan", str(CASES[1]), "--transcription", "trapezoidal", "--segments", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: trapezoidal: ") and "'segments'" in err
+
+
+def test_paper_benchmark_takes_another_transcription(tmp_path, capsys):
+    shutil.copy(CASES[1], tmp_path / CASES[1].name)
+    rows = run_paper_benchmark(tmp_path, tmp_path / "out", repeats=1, dynamics=("casadi-rnea",),
+                               transcription="hermite-simpson", knots=(10,))
+    assert (rows[0]["transcription"], rows[0]["knots"], rows[0]["status"]) == ("hermite-simpson", 10, "verified")
+    assert "hermite-simpson + ipopt" in capsys.readouterr().out

@@ -1,0 +1,73 @@
+"""next_refinement on hand-made verifications: where the checks go, how the margin grows and the limits shrink."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ocpkit.nlp import Refinement
+from ocpkit.refine import LIMIT_BACKOFF, MIN_MARGIN_STEP, MIN_SHRINK, PENETRATION_FACTOR, margin_step, next_refinement
+from ocpkit.verify import Check, Verification
+
+
+def verification(times=(0.3, 0.1), **worst) -> Verification:
+    """A verification whose checks have the given worst values (tolerance 0.01 for limits, 0 for contact)."""
+    tolerance = {"obstacle": 0.0, "self_collision": 0.0, "workspace": 0.0}
+    checks = tuple(Check(name, value, tolerance.get(name, 0.01), 0.2, "rel") for name, value in worst.items())
+    return Verification(checks, np.asarray(times, dtype=float))
+
+
+def test_nothing_to_refine_when_verified():
+    ok = verification(velocity=0.0, obstacle=-0.02)
+    assert ok.ok and next_refinement(Refinement(), ok, 2.0) is None
+
+
+def test_nothing_to_refine_without_violation_times():
+    boundary_only = verification(times=(), boundary=1.0)
+    assert not boundary_only.ok and next_refinement(Refinement(), boundary_only, 2.0) is None
+
+
+def test_check_fractions_put_the_newest_violations_first():
+    previous = Refinement(check_fractions=np.array([0.5, 0.9]))
+    following = next_refinement(previous, verification((0.3, 0.1), obstacle=0.001), tf=2.0)
+    np.testing.assert_allclose(following.check_fractions, [0.15, 0.05, 0.5, 0.9])
+
+
+@pytest.mark.parametrize("penetration, step", [(0.001, 0.005), (0.0025, 0.005), (0.01, 0.02)])
+def test_margin_grows_by_twice_the_penetration_at_least_5_mm(penetration, step):
+    following = next_refinement(Refinement(extra_margin=0.01), verification(obstacle=penetration), 1.0)
+    assert following.extra_margin == pytest.approx(0.01 + step)
+    assert step == max(PENETRATION_FACTOR * penetration, MIN_MARGIN_STEP)
+
+
+def test_the_deepest_contact_of_any_kind_sets_the_margin_step():
+    following = next_refinement(Refinement(), verification(obstacle=0.004, self_collision=0.006, workspace=0.001), 1.0)
+    assert following.extra_margin == pytest.approx(0.012)
+
+
+def test_limit_violation_alone_keeps_the_margin_and_shrinks_the_limits():
+    following = next_refinement(Refinement(limit_scale=0.9), verification(velocity=0.03, obstacle=-0.05), 1.0)
+    excess = 0.03 - 0.01
+    assert following.extra_margin == 0.0
+    assert following.limit_scale == pytest.approx(0.9 * (1.0 - excess - LIMIT_BACKOFF))
+
+
+def test_the_largest_limit_excess_sets_the_shrink():
+    found = verification(velocity=0.02, torque=0.05, torque_rate=0.03)
+    assert next_refinement(Refinement(), found, 1.0).limit_scale == pytest.approx(1.0 - 0.04 - LIMIT_BACKOFF)
+
+
+def test_contact_alone_keeps_the_limit_scale():
+    following = next_refinement(Refinement(limit_scale=0.8), verification(torque=0.005, obstacle=0.002), 1.0)
+    assert following.limit_scale == 0.8
+
+
+def test_margin_step_is_zero_without_contact():
+    assert margin_step(0.0) == 0.0
+    assert margin_step(-0.01) == 0.0
+    assert margin_step(1e-6) == MIN_MARGIN_STEP
+
+
+def test_a_large_limit_excess_shrinks_the_limits_by_at_most_min_shrink():
+    following = next_refinement(Refinement(), verification(torque=1.2), 1.0)  # torque 120 % over its limit
+    assert following.limit_scale == MIN_SHRINK
