@@ -5,12 +5,14 @@ from __future__ import annotations
 import importlib.metadata
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 from numpy.polynomial import Polynomial
 
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
+from ocpkit.nlp import Refinement
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
 from ocpkit.trajectory import Samples, Trajectory
@@ -41,6 +43,15 @@ def discretize(problem: Problem, transcription: str, dynamics: str = "casadi", *
     default constraints, without a solver."""
     method = TRANSCRIPTIONS.get(transcription)(**options)
     return method.build(problem, make_dynamics(dynamics, problem.robot), make_constraints(problem))
+
+
+def evaluate(discretization: Discretization, w: np.ndarray, problem: Problem, refinement: Refinement | None = None
+             ) -> tuple[float, np.ndarray]:
+    """(f, g (n_g,)) of the discretization's NLP at w with `problem`'s parameters after `refinement`."""
+    nlp = discretization.nlp
+    f = ca.Function("nlp", [nlp.x, nlp.p], [nlp.f, nlp.g])
+    value, g = f(w, discretization.parameters(problem, refinement or Refinement()))
+    return float(value), np.asarray(g).ravel()
 
 
 def polynomial_motion(problem: Problem, tf: float, shape: Polynomial) -> Trajectory:

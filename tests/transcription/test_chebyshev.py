@@ -8,7 +8,7 @@ import dataclasses
 import casadi as ca
 import numpy as np
 import pytest
-from helpers import REPO, discretize
+from helpers import REPO, discretize, evaluate
 from test_verify import quintic
 
 from ocpkit import load_scenario
@@ -26,13 +26,6 @@ def disc():
     return discretize(PROBLEM, "chebyshev", knots=KNOTS)
 
 
-def evaluate(disc, w, problem=PROBLEM, refinement=None):
-    nlp = disc.nlp
-    f = ca.Function("nlp", [nlp.x, nlp.p], [nlp.f, nlp.g])
-    value, g = f(w, disc.parameters(problem, refinement or Refinement()))
-    return float(value), np.asarray(g).ravel()
-
-
 def checks(disc) -> int:
     """Number of check points (fixed and adaptive): columns of the lifted check q (n, checks)."""
     return disc.nlp.variables.index("q_check").shape[1]
@@ -41,7 +34,7 @@ def checks(disc) -> int:
 def test_dynamics_and_collocation_hold_exactly_on_a_polynomial_motion(disc):
     nlp = disc.nlp
     w = disc.encode(quintic(PROBLEM, 2.0))
-    _, g = evaluate(disc, w)
+    _, g = evaluate(disc, w, PROBLEM)
     equalities = nlp.lbg == nlp.ubg
     assert equalities.sum() == (KNOTS + 1) * 3 * 6 + 6 * checks(disc)  # D Q, D Qd, dynamics; check-point q
     assert np.abs(g[equalities]).max() < 1e-8
@@ -49,16 +42,16 @@ def test_dynamics_and_collocation_hold_exactly_on_a_polynomial_motion(disc):
 
 def test_collocation_detects_a_motion_that_is_not_a_derivative(disc):
     w = disc.encode(quintic(PROBLEM, 2.0))
-    _, g0 = evaluate(disc, w)
+    _, g0 = evaluate(disc, w, PROBLEM)
     w[disc.nlp.variables.index("qd")[0]] += 0.1  # velocity of knot 0 no longer the derivative of the position
-    _, g = evaluate(disc, w)
+    _, g = evaluate(disc, w, PROBLEM)
     equalities = disc.nlp.lbg == disc.nlp.ubg
     assert np.abs(g0[equalities]).max() < 1e-8 and np.abs(g[equalities]).max() > 0.05
 
 
 def test_cost_is_tf_plus_weighted_jerk_integral(disc):
     tf = 2.0
-    value, _ = evaluate(disc, disc.encode(quintic(PROBLEM, tf)))
+    value, _ = evaluate(disc, disc.encode(quintic(PROBLEM, tf)), PROBLEM)
     delta = PROBLEM.goal - PROBLEM.start
     x = np.linspace(0, 1, 200001)
     jerk_shape = np.trapezoid((60 - 360 * x + 360 * x**2) ** 2, x)  # ∫_0^1 (d³s/dx³)² dx of the quintic
@@ -118,7 +111,7 @@ def test_moved_obstacle_changes_the_parameters_not_the_nlp(disc):
     np.testing.assert_allclose(p.read(disc.parameters(moved), "collision.obstacle_center"),
                                moved.scene.obstacle_centers)
     w = disc.encode(quintic(PROBLEM, 2.0))
-    assert not np.allclose(evaluate(disc, w, moved)[1], evaluate(disc, w)[1])
+    assert not np.allclose(evaluate(disc, w, moved)[1], evaluate(disc, w, PROBLEM)[1])
 
 
 def test_check_fractions_move_the_adaptive_slots(disc):

@@ -6,10 +6,9 @@ from __future__ import annotations
 
 import functools
 
-import casadi as ca
 import numpy as np
 import pytest
-from helpers import REPO, discretize, monomial, polynomial_motion
+from helpers import REPO, discretize, evaluate, monomial, polynomial_motion
 from numpy.polynomial import Legendre, Polynomial
 
 import ocpkit
@@ -114,13 +113,6 @@ def disc(setup):
     return build(setup)
 
 
-def evaluate(disc, w, refinement=None):
-    nlp = disc.nlp
-    f = ca.Function("nlp", [nlp.x, nlp.p], [nlp.f, nlp.g])
-    value, g = f(w, disc.parameters(PROBLEM, refinement or Refinement()))
-    return float(value), np.asarray(g).ravel()
-
-
 def columns(disc) -> int:
     """Knot columns KN + 1 (joints shared), as the grid says."""
     return disc.grid.K * N + 1
@@ -134,9 +126,9 @@ def test_equalities_vanish_exactly_on_motions_of_degree_n(setup, disc):
     # D Q, D Qd at the collocated points of every segment; dynamics once per column; lifted check q
     assert equalities.sum() == 6 * (2 * K * collocated + (K * N + 1) + checks)
     for shape in (monomial(N), Polynomial([0.0, 0.3, -0.2, 0.9, 0.4, -0.3])):
-        _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)))
+        _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)), PROBLEM)
         assert np.abs(g[equalities]).max() < 1e-9, shape
-    _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, monomial(N + 1))))
+    _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, monomial(N + 1))), PROBLEM)
     assert np.abs(g[equalities]).max() > 1e-5  # one degree more and the defects show
 
 
@@ -148,9 +140,9 @@ def test_radau_leaves_the_slope_at_t_f_free():
     for setup in ("lgl", "lgr"):
         disc = build(setup)
         w = disc.encode(motion)
-        _, g0 = evaluate(disc, w)
+        _, g0 = evaluate(disc, w, PROBLEM)
         w[disc.nlp.variables.index("qd")[0, 2]] += 0.1  # column 0 is t = t_f
-        _, g1 = evaluate(disc, w)
+        _, g1 = evaluate(disc, w, PROBLEM)
         equalities = disc.nlp.lbg == disc.nlp.ubg
         changed[setup] = np.abs(g1 - g0)[equalities] > 1e-6
         assert np.abs(g0[equalities]).max() < 1e-9
@@ -166,7 +158,7 @@ def test_cost_is_tf_plus_the_exact_jerk_integral(disc):
     N, LGL 2N − 1, LGR 2N − 2)."""
     delta = PROBLEM.goal - PROBLEM.start
     for shape in (monomial(5), Polynomial([0.0, 0.5, 0.0, 0.5, -0.2, 0.1])):
-        value, _ = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)))
+        value, _ = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)), PROBLEM)
         third = shape.deriv(3)
         expected = TF + PROBLEM.mu * np.sum(PROBLEM.jerk_weights * delta**2) * (third * third).integ()(1.0) / TF**5
         assert value == pytest.approx(expected, rel=1e-9), shape
@@ -179,7 +171,7 @@ def test_lgr_cost_is_the_exact_jerk_integral_for_motions_of_degree_n(n):
     disc = discretize(PROBLEM, "lgr", knots=n)
     delta = PROBLEM.goal - PROBLEM.start
     shape = Polynomial(np.r_[0.0, RNG.normal(size=n)])
-    value, _ = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)))
+    value, _ = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)), PROBLEM)
     third = shape.deriv(3)
     expected = TF + PROBLEM.mu * np.sum(PROBLEM.jerk_weights * delta**2) * (third * third).integ()(1.0) / TF**5
     assert value == pytest.approx(expected, rel=1e-9)

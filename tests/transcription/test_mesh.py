@@ -7,10 +7,9 @@ from __future__ import annotations
 import dataclasses
 import functools
 
-import casadi as ca
 import numpy as np
 import pytest
-from helpers import REPO, discretize, monomial, polynomial_motion
+from helpers import REPO, discretize, evaluate, monomial, polynomial_motion
 from numpy.polynomial import Polynomial
 
 import ocpkit
@@ -38,13 +37,6 @@ def method(request):
     return name, *METHODS[name], build(name)
 
 
-def evaluate(disc, w, refinement=None):
-    nlp = disc.nlp
-    f = ca.Function("nlp", [nlp.x, nlp.p], [nlp.f, nlp.g])
-    value, g = f(w, disc.parameters(PROBLEM, refinement or Refinement()))
-    return float(value), np.asarray(g).ravel()
-
-
 def test_equalities_vanish_exactly_on_the_motions_the_method_represents(method):
     _, N, degree, disc = method
     nlp = disc.nlp
@@ -53,9 +45,9 @@ def test_equalities_vanish_exactly_on_the_motions_the_method_represents(method):
     defects = 2 * N * (1 + disc.midpoints)  # q and q̇: trapezoid (+ Hermite interpolation) per interval
     assert equalities.sum() == 6 * (points + defects + N)  # + the lifted q of one check per interval
     for shape in (monomial(degree), Polynomial([0.0, 0.3, -0.2, 0.9][: degree + 1])):
-        _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)))
+        _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)), PROBLEM)
         assert np.abs(g[equalities]).max() < 1e-9, shape
-    _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, monomial(degree + 1))))
+    _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, monomial(degree + 1))), PROBLEM)
     assert np.abs(g[equalities]).max() > 1e-5  # one degree more and the defects show
 
 
@@ -66,12 +58,12 @@ def test_moved_checks_keep_the_equalities_exact(method):
     moved = Refinement(np.array([0.3, 0.61, 0.97]))
     check_at = nlp.parameters.read(disc.parameters(PROBLEM, moved), "check_at")
     assert np.count_nonzero(check_at != 0.5) == 3
-    _, g = evaluate(disc, w, moved)
+    _, g = evaluate(disc, w, PROBLEM, moved)
     assert np.abs(g[nlp.lbg == nlp.ubg]).max() > 1e-5  # the checks encoded at σ = ½ are off the moved ones
     checks = layout.index("q_check")  # (N, n)
     for k in range(N):  # encode samples the checks at their default σ; lift them to the moved ones
         w[checks[k]] = disc.decode(w).interpolant(np.array([TF * (k + check_at[k]) / N])).q[0]
-    _, g = evaluate(disc, w, moved)
+    _, g = evaluate(disc, w, PROBLEM, moved)
     assert np.abs(g[nlp.lbg == nlp.ubg]).max() < 1e-9
 
 
@@ -124,7 +116,7 @@ def test_cost_is_tf_plus_the_exact_jerk_integral(method):
     delta = PROBLEM.goal - PROBLEM.start
     shapes = [monomial(3), Polynomial([0.0, 0.5, 0.0, 0.5])] + ([monomial(4)] if name == "hermite-simpson" else [])
     for shape in shapes:
-        value, _ = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)))
+        value, _ = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)), PROBLEM)
         third = shape.deriv(3)
         jerk_shape = (third * third).integ()(1.0)  # ∫_0^1 (d³p/dx³)² dx
         expected = TF + PROBLEM.mu * np.sum(PROBLEM.jerk_weights * delta**2) * jerk_shape / TF**5
@@ -138,7 +130,7 @@ def test_torque_rate_is_bounded_by_the_one_sided_slopes_at_the_knots():
     nlp, layout = disc.nlp, disc.nlp.variables
     r, N, n = PROBLEM.robot, disc.N, disc.n
     w = disc.encode(polynomial_motion(PROBLEM, 10.0, monomial(3)))  # slow: tiny torque rates of its own
-    _, base = evaluate(disc, w)
+    _, base = evaluate(disc, w, PROBLEM)
     h = 10.0 / N
     knot_u, mid_u = layout.index("u")[:, joint], layout.index("M")[:, 3 * n + joint]
 
@@ -150,7 +142,7 @@ def test_torque_rate_is_bounded_by_the_one_sided_slopes_at_the_knots():
         step[knot_u[k + 1:]] += 4 * a
         step[mid_u[k]] += a
         step[mid_u[k + 1:]] += 4 * a
-        _, g = evaluate(disc, step)
+        _, g = evaluate(disc, step, PROBLEM)
         rate_rows = np.isneginf(nlp.lbg) & (nlp.ubg == 0.0)
         return rate_rows & (g > 1e-9) & (base <= 1e-9)
 

@@ -9,7 +9,7 @@ import functools
 import casadi as ca
 import numpy as np
 import pytest
-from helpers import REPO, discretize, monomial, polynomial_motion
+from helpers import REPO, discretize, evaluate, monomial, polynomial_motion
 from numpy.polynomial import Polynomial
 
 import ocpkit
@@ -144,13 +144,6 @@ def test_the_objective_and_the_lagrangian_do_not_couple_stages(name):
     assert len(set(stage[rows])) == len(nlp.stages.nx)  # every stage has curvature
 
 
-def evaluate(disc, w, refinement=None):
-    nlp = disc.nlp
-    f = ca.Function("nlp", [nlp.x, nlp.p], [nlp.f, nlp.g])
-    value, g = f(w, disc.parameters(PROBLEM, refinement or Refinement()))
-    return float(value), np.asarray(g).ravel()
-
-
 def test_staged_and_unstaged_agree_on_exact_motions(name):
     _, degree = METHODS[name]
     staged, plain = build(name, True), build(name, False)
@@ -162,8 +155,8 @@ def test_staged_and_unstaged_agree_on_exact_motions(name):
     exact = (monomial(degree), Polynomial([0.0, 0.3, -0.2, 0.9][: degree + 1]))
     for shape in exact + (monomial(degree + 1), Polynomial([0.0, 0.0, 3.0, -2.0, 0.5])):
         motion = polynomial_motion(PROBLEM, TF, shape)
-        f_staged, g_staged = evaluate(staged, staged.encode(motion))
-        f_plain, g_plain = evaluate(plain, plain.encode(motion))
+        f_staged, g_staged = evaluate(staged, staged.encode(motion), PROBLEM)
+        f_plain, g_plain = evaluate(plain, plain.encode(motion), PROBLEM)
         if shape in exact:
             for disc, g in ((staged, g_staged), (plain, g_plain)):
                 equalities = disc.nlp.lbg == disc.nlp.ubg
