@@ -1,5 +1,10 @@
 """Exceptions for user mistakes: each message names the offending item so it can be fixed."""
 
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 
 class OcpkitError(Exception):
     """Base class of every error ocpkit raises for bad input; the CLI prints it without a traceback."""
@@ -19,3 +24,12 @@ class RegistryError(OcpkitError):
 
 class OptionError(OcpkitError):
     """A planner, transcription or solver option is out of range."""
+
+
+@contextmanager
+def within(where: object) -> Iterator[None]:
+    """Prefix an OcpkitError raised inside with `where: ` (e.g. the file it is about), keeping its type."""
+    try:
+        yield
+    except OcpkitError as exc:
+        raise type(exc)(f"{where}: {exc}") from exc

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ocpkit import interrupt
 from ocpkit.errors import OptionError
 from ocpkit.plan import Plan
 from ocpkit.problem import Problem
@@ -27,12 +28,23 @@ GUESSES: Registry[Callable[[Problem, Discretization], np.ndarray]] = Registry("i
 
 def plan(problem: Problem, planner: str = "simultaneous", **options: Any) -> Plan:
     """Validate `problem` (ocpkit.validation) and plan it with the named planner; `options` go to that planner
-    (e.g. `ocpkit.simultaneous.plan_simultaneous`); one it does not take is an OptionError."""
+    (e.g. `ocpkit.simultaneous.plan_simultaneous`); one it does not take is
+    an OptionError. Ctrl-C during the plan raises KeyboardInterrupt even if the solver caught it
+    (ocpkit.interrupt): an interrupted plan never returns."""
     validate(problem)
     function = PLANNERS.get(planner)
+    _check_options(planner, function, problem, options)
+    with interrupt.watching():
+        result = function(problem, **options)
+        interrupt.check()
+    return result
+
+
+def _check_options(planner: str, function: Callable[..., Plan], problem: Problem, options: dict) -> None:
+    """OptionError if `function` does not take `options`."""
+    signature = inspect.signature(function)
     try:
-        inspect.signature(function).bind(problem, **options)
+        signature.bind(problem, **options)
     except TypeError as exc:
         raise OptionError(f"planner {planner!r}: {exc}; its options: "
-                          f"{', '.join(list(inspect.signature(function).parameters)[1:])}") from exc
-    return function(problem, **options)
+                          f"{', '.join(list(signature.parameters)[1:])}") from exc

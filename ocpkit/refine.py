@@ -6,17 +6,23 @@ least MIN_MARGIN_STEP), shrinks the velocity, torque and torque-rate limits the 
 LIMIT_BACKOFF (to no less than MIN_SHRINK of them in one round), and re-solves warm-started from the last
 solution, all through NLP parameters (no rebuild). A check at the worst time alone rarely suffices: with the
 constraint active, the interpolant then dips just beside the new check.
+
+Every solve's w is checked against its variable bounds (slack: `solvers.bound_slack`): an
+iterate outside them (a diverged solver) ends the plan as `failed`, the message naming the variable. All solves
+share one wall-time `deadline`: each gets the time that is left, and no round starts after it.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from ocpkit.nlp import Refinement
+from ocpkit.nlp import Layout, Refinement
 from ocpkit.problem import Problem
-from ocpkit.solvers import PreparedSolver, SolverResult, SolverStatus
+from ocpkit.solvers import PreparedSolver, SolverResult, SolverStatus, bound_slack
 from ocpkit.trajectory import Trajectory
 from ocpkit.transcription import Discretization
 from ocpkit.verify import Verification, verify
@@ -26,6 +32,7 @@ MIN_MARGIN_STEP = 0.005  # m
 PENETRATION_FACTOR = 2.0
 LIMIT_BACKOFF = 0.005  # fraction of each limit
 MIN_SHRINK = 0.5  # one round never takes more than half of a limit away
+NAMED_PARTS = ("tf", "q", "qd", "qdd", "u")  # parts of w an out-of-bounds message names (Discretization)
 
 
 @dataclass(frozen=True)
@@ -58,16 +65,47 @@ def margin_step(penetration: float) -> float:
 
 
 def solve_refined(discretization: Discretization, solver: PreparedSolver, problem: Problem, guess: np.ndarray,
-                  rounds: int = DEFAULT_ROUNDS) -> Refined:
-    """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds."""
+                  rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf) -> Refined:
+    """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds, all
+    before `deadline` (time.perf_counter s)."""
     refinement, iterations, taken = Refinement(), 0, 0
     while True:
-        result = solver.solve(guess, discretization.parameters(problem, refinement),
-                              discretization.bounds(problem, refinement))
+        bounds = discretization.bounds(problem, refinement)
+        result = solver.solve(guess, discretization.parameters(problem, refinement), bounds,
+                              max_wall_time=max(deadline - time.perf_counter(), 0.0))
+        result = checked(result, discretization.nlp.variables, bounds)
         iterations += result.iterations
         trajectory = discretization.decode(result.w)
         verification = verify(problem, trajectory)
         following = next_refinement(refinement, verification, trajectory.tf)
+        if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
+            result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
+                                         message=f"wall-time limit reached before refinement round {taken + 1}")
         if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds:
             return Refined(result, trajectory, verification, iterations, taken)
         refinement, guess, taken = following, result.w, taken + 1
+
+
+def checked(result: SolverResult, layout: Layout, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+    """`result`, or a `failed` one naming the worst variable of its w outside `bounds` (lbx, ubx) (n_w,)."""
+    lbx, ubx = bounds
+    outside = np.nan_to_num(np.maximum(lbx - result.w, result.w - ubx) / bound_slack(lbx, ubx), nan=np.inf)
+    worst = int(np.argmax(outside))
+    if outside[worst] <= 1.0:
+        return result
+    name = _variable_name(layout, worst)
+    unit = " s" if name == "t_f" else ""
+    where = f"{name} = {result.w[worst]:.6g}{unit} outside [{lbx[worst]:.6g}, {ubx[worst]:.6g}]{unit}"
+    return dataclasses.replace(result, status=SolverStatus.FAILED,
+                               message=f"iterate outside its bounds, {where}; solver: {result.message}")
+
+
+def _variable_name(layout: Layout, position: int) -> str:
+    """The name of entry `position` of w: t_f, or e.g. "qd[knot 3, joint 2]" (1-based joint), else "w[i]"."""
+    for name in NAMED_PARTS:
+        if name in layout and position in layout.index(name):
+            index = np.argwhere(layout.index(name) == position)[0]
+            if name == "tf":
+                return "t_f"
+            return f"{name}[knot {index[0]}, joint {index[-1] + 1}]" if len(index) == 2 else f"{name}[{index[0]}]"
+    return f"w[{position}]"

@@ -6,14 +6,16 @@ across queries), an initial guess, the solve with refinement rounds (ocpkit.refi
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Sequence
 
 import numpy as np
 
-from ocpkit.build_cache import build
+from ocpkit.build_cache import build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
 from ocpkit.dynamics import Dynamics
+from ocpkit.errors import OptionError
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
@@ -32,19 +34,25 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
                       refinements: int = DEFAULT_ROUNDS,
                       constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
                       transcription_options: dict | None = None, solver_options: dict | None = None,
-                      dynamics_options: dict | None = None) -> Plan:
+                      dynamics_options: dict | None = None, max_wall_time: float = 60.0,
+                      guess_options: dict | None = None) -> Plan:
     """Plan `problem` with path and timing together.
 
     `knots` is N, the intervals per segment of a pseudospectral transcription (K N + 1 points on K `segments`) or
-    the mesh intervals of a local one; `guess` names a registered initial-guess rule ("line": the
-    paper's straight joint-space line; "ompl": the OMPL + TOPP-RA baseline's motion) or is a decision vector for
-    this shape; `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess
-    is part of the computation time; the one-time set-up is not."""
+    the mesh intervals of a local one; `guess` names a registered initial-guess rule ("line": the paper's straight
+    joint-space line; "ompl": the OMPL + TOPP-RA baseline's motion) or is a decision vector for this shape, with
+    `guess_options` for the rule (e.g. {"seed": 3, "planning_time": 2.0} for "ompl", the baseline's options);
+    `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess is part of
+    the computation time; the one-time set-up is not. `max_wall_time` (s) bounds the computation
+    (guess, every solve and refinement round): each solve gets the time left (a solver that cannot be
+    interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when it
+    runs out."""
     started = time.perf_counter()
     made = build(problem, transcription, knots, dynamics, solver, constraints, transcription_options,
                  solver_options, dynamics_options)
-    w = GUESSES.get(guess)(problem, made.discretization) if isinstance(guess, str) else np.asarray(guess, float)
-    refined = solve_refined(made.discretization, made.solver, problem, w, refinements)
+    deadline = time.perf_counter() + max_wall_time
+    w = _guess(problem, made.discretization, guess, guess_options or {})
+    refined = solve_refined(made.discretization, made.solver, problem, w, refinements, deadline)
     result = refined.result
     method = {"planner": "simultaneous", "transcription": transcription, "knots": knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": solver}
@@ -52,3 +60,15 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=made.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
                   verification=refined.verification)
+
+
+def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray, options: dict) -> np.ndarray:
+    """The decision vector w₀ (n_w,) of the named guess rule (with `options`), or `guess` itself; OptionError if its
+    length is not n_w."""
+    if isinstance(guess, str):
+        return construct(functools.partial(GUESSES.get(guess), problem, discretization), f"guess {guess!r}", options)
+    w = np.asarray(guess, dtype=float)
+    expected = discretization.nlp.variables.size
+    if w.shape != (expected,):
+        raise OptionError(f"the guess vector has shape {w.shape}, this NLP needs {expected} values (n_w)")
+    return w

@@ -1,40 +1,101 @@
-"""Checks every Problem gets before planning, however it was made (a scenario file or Python)."""
+"""Checks every Problem gets before planning, however it was made (a scenario file or Python).
+
+First the numbers alone (shapes, finiteness, signs, order; the same messages as for a scenario file), then what
+needs the robot: joint limits, collisions, the torque that holds start and goal against gravity, and t_f against
+the velocity limits."""
 
 from __future__ import annotations
 
+import dataclasses
+from typing import Any
+
 import numpy as np
+import pinocchio as pin
 
 from ocpkit.errors import ScenarioError
 from ocpkit.geometry import collision_report
-from ocpkit.problem import Problem
+from ocpkit.problem import Problem, TimeBounds
+from ocpkit.robots import Robot
+from ocpkit.scene import Scene
+from ocpkit.schema import COST, OBSTACLE, TIME, WORKSPACE, check, show
 
 LIMIT_SLACK = 1e-9  # rad: a start or goal exactly at a limit, given in degrees, must not fail on round-off
+GRAVITY_SLACK = 1e-6  # relative: holding torque may exceed tau_max by round-off only
 
 
 def validate(problem: Problem) -> None:
-    """Raise ScenarioError if a number is malformed, start or goal is outside the joint limits or in collision,
-    or t_f is impossible."""
+    """Raise ScenarioError naming the field if a number is malformed, start or goal is outside the joint limits,
+    in collision or cannot be held against gravity, or t_f is impossible."""
     robot = problem.robot
-    for label in ("start", "goal"):
-        q = np.asarray(getattr(problem, label))
-        if q.shape != (robot.n,) or not np.all(np.isfinite(q)):
-            raise ScenarioError(f"{label} needs {robot.n} finite joint values, got {q.tolist()}")
-    if not (np.isfinite(problem.mu) and problem.mu >= 0):
-        raise ScenarioError(f"cost.mu must be a finite number ≥ 0, got {problem.mu}")
-    t = problem.time
-    if not (np.isfinite(t.max) and 0 < t.min <= t.guess <= t.max):
-        raise ScenarioError(f"time bounds need 0 < min ≤ guess ≤ max, finite; got min={t.min}, guess={t.guess}, "
-                            f"max={t.max}")
-    for label, q in (("start", problem.start), ("goal", problem.goal)):
-        outside = (q < robot.q_lower - LIMIT_SLACK) | (q > robot.q_upper + LIMIT_SLACK)
-        for i in np.nonzero(outside)[0]:
-            raise ScenarioError(
-                f"{label}: joint {i + 1} ({robot.joint_names[i]}) = {np.degrees(q[i]):.2f} deg is outside "
-                f"[{np.degrees(robot.q_lower[i]):.2f}, {np.degrees(robot.q_upper[i]):.2f}] deg")
+    points = {label: _joint_values(getattr(problem, label), label, robot.n) for label in ("start", "goal")}
+    check({"mu": problem.mu}, COST, ScenarioError, "cost")
+    _check_time(problem.time)
+    _check_scene(problem.scene)
+    for label, q in points.items():
+        _check_limits(robot, q, label)
         contacts = collision_report(robot, problem.scene, q)
         if contacts:
             raise ScenarioError(f"{label} configuration is in collision: " + "; ".join(contacts))
+        _check_gravity(robot, q, label)
     lower_bound = problem.velocity_lower_bound()
     if problem.time.max < lower_bound:
         raise ScenarioError(f"time.max = {problem.time.max} s is below the velocity-limited minimum "
                             f"{lower_bound:.3f} s (max_i |goal_i - start_i| / qd_max_i)")
+
+
+def _float_array(value: Any, label: str) -> np.ndarray:
+    """`value` itself if it is a numpy array of numbers; ScenarioError naming `label` otherwise."""
+    if not (isinstance(value, np.ndarray) and value.dtype.kind in "fiu"):
+        raise ScenarioError(f"{label} must be a numpy array of numbers, got {show(value)}")
+    return value
+
+
+def _joint_values(value: Any, label: str, n: int) -> np.ndarray:
+    """Start or goal (rad): n finite values."""
+    q = _float_array(value, label)
+    if q.shape != (n,) or not np.all(np.isfinite(q)):
+        raise ScenarioError(f"{label} needs {n} finite joint values, got {show(q.tolist())}")
+    return q
+
+
+def _check_time(t: TimeBounds) -> None:
+    """Each bound finite and > 0 (seconds), min ≤ max and min ≤ guess ≤ max."""
+    check(dataclasses.asdict(t), TIME, ScenarioError, "time")
+    if not t.min <= t.max:
+        raise ScenarioError(f"time bounds need 0 < min ≤ max, got min={t.min}, max={t.max}")
+    if not t.min <= t.guess <= t.max:
+        raise ScenarioError(f"time.guess = {t.guess} must lie in [{t.min}, {t.max}]")
+
+
+def _check_scene(scene: Scene) -> None:
+    """Obstacle centres (S, 3) finite, radii (S,) finite and > 0; workspace corners (3,) finite, min < max (m)."""
+    centers = _float_array(scene.obstacle_centers, "scene.obstacle_centers")
+    radii = _float_array(scene.obstacle_radii, "scene.obstacle_radii")
+    if centers.ndim != 2 or centers.shape[1] != 3 or radii.shape != centers.shape[:1]:
+        raise ScenarioError(f"scene: obstacle centres need shape (S, 3) and radii (S,), got {centers.shape} and "
+                            f"{radii.shape}")
+    for k, (center, radius) in enumerate(zip(centers.tolist(), radii.tolist())):
+        check({"sphere": {"center": center, "radius": radius}}, OBSTACLE, ScenarioError, f"scene.obstacles[{k}]")
+    if scene.workspace is not None:
+        lower = _float_array(scene.workspace.lower, "scene.workspace.min")
+        upper = _float_array(scene.workspace.upper, "scene.workspace.max")
+        check({"min": lower.tolist(), "max": upper.tolist()}, WORKSPACE, ScenarioError, "scene.workspace")
+        if np.any(lower >= upper):
+            raise ScenarioError(f"scene.workspace: min {lower} must be below max {upper}")
+
+
+def _check_limits(robot: Robot, q: np.ndarray, label: str) -> None:
+    outside = (q < robot.q_lower - LIMIT_SLACK) | (q > robot.q_upper + LIMIT_SLACK)
+    for i in np.nonzero(outside)[0]:
+        raise ScenarioError(
+            f"{label}: joint {i + 1} ({robot.joint_names[i]}) = {np.degrees(q[i]):.2f} deg is outside "
+            f"[{np.degrees(robot.q_lower[i]):.2f}, {np.degrees(robot.q_upper[i]):.2f}] deg")
+
+
+def _check_gravity(robot: Robot, q: np.ndarray, label: str) -> None:
+    """The torque holding q at rest, rnea(q, 0, 0) + friction(0) (N m), must lie within tau_max."""
+    zero = np.zeros(robot.n)
+    hold = pin.rnea(robot.model, robot.model.createData(), q, zero, zero) + robot.friction(zero)
+    for i in np.nonzero(np.abs(hold) > robot.tau_max * (1 + GRAVITY_SLACK))[0]:
+        raise ScenarioError(f"{label}: joint {i + 1} ({robot.joint_names[i]}) needs {abs(hold[i]):.1f} N m to hold "
+                            f"it against gravity, above its torque limit {robot.tau_max[i]:.1f} N m")

@@ -9,6 +9,12 @@ within the stated tolerance:
   self_collision, obstacle, workspace       worst sphere penetration, metres (negative: the smallest
                                              clearance);  tolerance 0 (no contact allowed)
   boundary    |q − q_start/goal|, |qd|, |qdd| at t = 0 and t_f (rad, rad/s, rad/s²);  tolerance 1e-6
+  qd_consistency, qdd_consistency            whether the samples are self-consistent, as an outside checker
+             sees them: by the mean value theorem the difference quotient of q (of qd) over one sample step
+             lies between qd (qdd) at the step's ends; the worst distance outside, relative to the joint's
+             velocity limit (qd) or to the motion's peak acceleration (qdd, over all joints);  tolerances 1 %
+             and 5 % (exact up to O(dt²) for smooth motions, and a jump of qdd, as TOPP-RA's bang-bang timing
+             has, stays inside the range; a non-converged iterate misses by tens of percent)
 
 A trajectory whose t_f is not finite or lies outside the problem's time bounds by more than 1 % (a solver's
 diverged iterate can have an absurd t_f) fails the single check `motion_time` (relative excess) instead and is
@@ -26,13 +32,14 @@ import numpy as np
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
-from ocpkit.trajectory import Samples, Trajectory
+from ocpkit.trajectory import TIME_TOLERANCE, Samples, Trajectory, time_excess
 
 LIMIT_TOLERANCE = 0.01
 DYNAMICS_TOLERANCE = 0.01
 GEOMETRY_TOLERANCE = 0.0
 BOUNDARY_TOLERANCE = 1e-6
-TIME_TOLERANCE = 0.01
+QD_CONSISTENCY_TOLERANCE = 0.01
+QDD_CONSISTENCY_TOLERANCE = 0.05
 GEOMETRY_CHECKS = ("self_collision", "obstacle", "workspace")
 SCALED_LIMITS = ("velocity", "torque", "torque_rate")
 
@@ -103,6 +110,7 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
     checks.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))
     checks += [_worst(name, v, GEOMETRY_TOLERANCE, samples.t, "m") for name, v in penetration.items()]
     checks.append(_boundary(problem, samples))
+    checks += _consistency(problem, samples)
     path_violation = np.max([_per_time(v) - LIMIT_TOLERANCE for v in excess.values()]
                             + [_per_time(v) for v in penetration.values()], axis=0)
     return Verification(tuple(checks), _peak_times(samples.t, path_violation))
@@ -110,8 +118,7 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
 
 def _motion_time_outside_bounds(problem: Problem, tf: float) -> Check | None:
     """The failed `motion_time` check if t_f (s) is not finite or outside the time bounds beyond tolerance."""
-    bounds = problem.time
-    excess = max(tf / bounds.max - 1.0, 1.0 - tf / bounds.min) if np.isfinite(tf) else np.inf
+    excess = time_excess(tf, problem.time.min, problem.time.max)
     if excess <= TIME_TOLERANCE:
         return None
     return Check("motion_time", float(excess), TIME_TOLERANCE, float(tf) if np.isfinite(tf) else 0.0, "rel")
@@ -133,6 +140,25 @@ def _worst(name: str, values: np.ndarray, tolerance: float, t: np.ndarray, unit:
     per_time = _per_time(values)
     k = int(np.argmax(per_time))
     return Check(name, float(per_time[k]), tolerance, float(t[k]), unit)
+
+
+def _consistency(problem: Problem, samples: Samples) -> list[Check]:
+    """The qd_consistency and qdd_consistency checks (module docstring) of the samples."""
+    quotient = np.diff(samples.qd, axis=0) / np.diff(samples.t)[:, None]
+    peak = max(np.abs(samples.qdd).max(), np.abs(quotient).max(), np.finfo(float).tiny)
+    t = samples.t[:-1]
+    return [_worst("qd_consistency", _mean_value_excess(samples.t, samples.q, samples.qd) / problem.robot.qd_max,
+                   QD_CONSISTENCY_TOLERANCE, t, "rel"),
+            _worst("qdd_consistency", _mean_value_excess(samples.t, samples.qd, samples.qdd) / peak,
+                   QDD_CONSISTENCY_TOLERANCE, t, "rel")]
+
+
+def _mean_value_excess(t: np.ndarray, x: np.ndarray, derivative: np.ndarray) -> np.ndarray:
+    """How far the difference quotient of x (m, n) over each step of t (m,) lies outside the range of
+    `derivative` (m, n) at the step's ends: shape (m − 1, n), in the units of `derivative`; ≤ 0 inside."""
+    quotient = np.diff(x, axis=0) / np.diff(t)[:, None]
+    ends = np.stack([derivative[:-1], derivative[1:]])
+    return np.maximum(ends.min(axis=0) - quotient, quotient - ends.max(axis=0))
 
 
 def _boundary(problem: Problem, samples: Samples) -> Check:

@@ -3,7 +3,9 @@ URDF and the scenario YAML (for the scene), and re-checks the samples with pinoc
 
 Usage: python tests/outside_check.py TRAJECTORY.json SPEC.yaml ROBOT.urdf SCENARIO.yaml
 Prints one line per check and exits 1 if any fails: limits within 1 %, tau within 1 % of the torque range
-of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no sphere contact.
+of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no sphere contact, and
+self-consistent samples: over each sample step the difference quotient of q (of qd) lies between qd (qdd) at
+the step's ends (mean value theorem), within 1 % of the velocity limit (5 % of the peak acceleration).
 """
 
 from __future__ import annotations
@@ -14,6 +16,23 @@ import sys
 import numpy as np
 import pinocchio as pin
 import yaml
+
+TOLERANCE = {"self_collision": 0.0, "obstacle": 0.0, "workspace": 0.0, "qdd_consistency": 0.05}  # others: 0.01
+
+
+def outside_range(t: np.ndarray, x: np.ndarray, derivative: np.ndarray) -> np.ndarray:
+    """Distance of each step's difference quotient of x from the range of `derivative` at the step's ends."""
+    quotient = np.diff(x, axis=0) / np.diff(t)[:, None]
+    low, high = np.minimum(derivative[:-1], derivative[1:]), np.maximum(derivative[:-1], derivative[1:])
+    return np.maximum(low - quotient, quotient - high)
+
+
+def consistency(s: dict[str, np.ndarray], velocity_limit: np.ndarray) -> dict[str, float]:
+    """Worst self-consistency of the samples: q against qd (relative to the velocity limit), qd against qdd
+    (relative to the peak of |qdd| and of the difference quotients of qd)."""
+    peak = max(np.abs(s["qdd"]).max(), np.abs(np.diff(s["qd"], axis=0) / np.diff(s["t"])[:, None]).max(), 1e-300)
+    return {"qd_consistency": np.max(outside_range(s["t"], s["q"], s["qd"]) / velocity_limit),
+            "qdd_consistency": np.max(outside_range(s["t"], s["qd"], s["qdd"]) / peak)}
 
 
 def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, float]:
@@ -33,6 +52,7 @@ def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, 
         "torque": np.max(np.abs(s["tau"]) / tau_max - 1),
         "torque_rate": np.max(np.abs(rate) / np.array(lim["torque_rate"]) - 1),
         "dynamics": np.max(np.abs(s["tau"] - needed) / (2 * tau_max)),
+        **consistency(s, np.array(lim["velocity"])),
     }
     centres = []
     for q in s["q"]:
@@ -61,7 +81,7 @@ def main(argv: list[str]) -> int:
         worst = check(json.load(t), yaml.safe_load(sp), urdf, yaml.safe_load(sc))
     failed = False
     for name, value in worst.items():
-        ok = value <= (0.0 if name in ("self_collision", "obstacle", "workspace") else 0.01)
+        ok = value <= TOLERANCE.get(name, 0.01)
         failed |= not ok
         print(f"{name:15s} {value:+.4f} {'ok' if ok else 'FAIL'}")
     return 1 if failed else 0

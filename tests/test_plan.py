@@ -122,3 +122,41 @@ def test_an_option_the_simultaneous_planner_does_not_take_lists_its_options():
     with pytest.raises(OptionError, match="'planner_name'") as error:
         ocpkit.plan(CASE2, planner_name="rrtconnect")
     assert all(option in str(error.value) for option in ("knots", "solver", "refinements", "constraints"))
+
+
+def verification_failing(*names: str) -> Verification:
+    """A verification whose named checks fail (and a passing torque check)."""
+    return Verification((Check("torque", -0.5, 0.01, 0.1, "rel"),)
+                        + tuple(Check(name, 0.5, 0.01, 0.1, "rel") for name in names), np.zeros(0))
+
+
+@pytest.mark.parametrize("stopped, failing, words", [
+    ("infeasible", (), "locally infeasible"),
+    ("iteration_limit", (), "raise max_iterations"),
+    ("time_limit", (), "raise max_wall_time"),
+    ("no_path", (), "raise planning_time"),
+    (None, ("dynamics",), "more knots or segments"),
+    (None, ("qd_consistency",), "more knots or segments"),
+    (None, ("obstacle", "velocity"), "contact remains"),
+    (None, ("torque_rate",), "a limit is exceeded"),
+    (None, ("motion_time",), "solver diverged"),
+])
+def test_the_hint_follows_the_cause(motion, stopped, failing, words):
+    result = finish(FREE, motion, stopped, {}, 0.0, message="Some_Status", verification=verification_failing(*failing))
+    assert words in result.hint
+    assert result.hint.count(". ") == 0  # one sentence
+
+
+def test_a_failed_plan_quotes_the_solvers_message(motion):
+    result = finish(FREE, motion, "failed", {}, 0.0, message="Search_Direction_Becomes_Too_Small",
+                    verification=PASSED)
+    assert "Search_Direction_Becomes_Too_Small" in result.hint
+
+
+def test_a_verified_plan_has_no_hint(motion):
+    assert finish(FREE, motion, None, {}, 0.0, verification=PASSED).hint == ""
+
+
+def test_a_plan_has_a_trajectory_unless_the_planner_says_it_found_none(motion):
+    assert finish(FREE, motion, None, {}, 0.0, verification=PASSED).found
+    assert not finish(FREE, motion, "no_path", {}, 0.0, verification=PASSED, found=False).found

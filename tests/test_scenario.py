@@ -39,10 +39,19 @@ def test_unit_rad_is_taken_as_is(case1):
     np.testing.assert_allclose(load(case1).start, load_scenario(CASE1).start)
 
 
-def test_malformed_yaml(tmp_path):
+def test_malformed_yaml_is_one_line_with_line_and_column(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("robot: industrial6\nstart: [0, 0\n")
-    with pytest.raises(ScenarioError, match="malformed YAML"):
+    with pytest.raises(ScenarioError, match="malformed YAML at line 3, column 1: .*expected ',' or ']'") as error:
+        load_scenario(bad)
+    assert "\n" not in str(error.value)
+    assert "(while parsing a flow sequence at line 2, column 8)" in str(error.value)
+
+
+def test_a_file_that_is_not_utf8_is_named(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_bytes(b"robot: \xff\n")
+    with pytest.raises(ScenarioError, match=r"bad.yaml: not UTF-8 text: byte 0xff at offset 7"):
         load_scenario(bad)
 
 
@@ -68,6 +77,35 @@ def test_unknown_key_is_named(case1):
     case1["obstacles"] = []
     with pytest.raises(ScenarioError, match="unknown keys \\['obstacles'\\]"):
         load(case1)
+
+
+@pytest.mark.parametrize("where, value, message", [
+    (("scene",), {"obstacle": []}, r"unknown keys \['scene.obstacle'\]; allowed: \['obstacles', 'workspace'\]"),
+    (("time",), {"maxx": 3}, r"unknown keys \['time.maxx'\]; allowed: \['guess', 'max', 'min'\]"),
+    (("scene", "obstacles", 0, "sphere"), {"center": [1, 0, 0], "radious": 0.2},
+     r"unknown keys \['scene.obstacles\[0\].sphere.radious'\]; allowed: \['center', 'radius'\]"),
+])
+def test_an_unknown_nested_key_is_named_with_its_path(case1, where, value, message):
+    parent = case1
+    for key in where[:-1]:
+        parent = parent[key]
+    parent[where[-1]] = value
+    with pytest.raises(ScenarioError, match=message):
+        load(case1)
+
+
+@pytest.mark.parametrize("time, guess", [({"max": 3}, 3.0), ({"max": 20}, 10.0), ({"min": 12, "max": 20}, 12.0),
+                                         ({}, 10.0)])
+def test_the_default_guess_is_10_s_clipped_into_the_time_bounds(case1, time, guess):
+    case1["time"] = time
+    assert load(case1).time.guess == guess
+
+
+def test_a_huge_value_is_echoed_cut_short(case1):
+    case1["start"] = list(range(100_000))
+    with pytest.raises(ScenarioError, match=r"'start' needs shape \(6,\), got \(100000,\): \[0, 1, 2") as error:
+        load(case1)
+    assert len(str(error.value)) < 200
 
 
 def test_wrong_vector_length(case1):
@@ -158,6 +196,6 @@ def test_an_edited_robot_spec_is_read_again_by_the_next_scenario_load(case1, tmp
 
     assert after.robot.qd_max[0] == pytest.approx(before.robot.qd_max[0] / 2)
     assert after.robot.key != before.robot.key
-    discretization = ocpkit.build(after, knots=4).discretization  # a new build: the robot's content changed
+    discretization = ocpkit.build(after, knots=6).discretization  # a new build: the robot's content changed
     upper = discretization.bounds(after)[1][discretization.nlp.variables.index("qd")[1:-1, 0]]  # inner knots
     np.testing.assert_allclose(upper, after.robot.qd_max[0])

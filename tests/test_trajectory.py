@@ -86,3 +86,25 @@ def test_write_json_sample_step_follows_dt(tmp_path):
     write_json(tmp_path / "out.json", linear(0.1), HEADER, dt=0.02)
     t = json.loads((tmp_path / "out.json").read_text())["samples"]["t"]
     np.testing.assert_allclose(t, [0.0, 0.02, 0.04, 0.06, 0.08, 0.1])
+
+
+@pytest.mark.parametrize("tf, words", [(4369.0, "outside the time bounds [0.1, 10] s"),
+                                       (0.05, "outside the time bounds"), (np.nan, "outside the time bounds")])
+def test_write_json_leaves_out_the_samples_of_a_tf_outside_the_time_bounds(tmp_path, tf, words):
+    write_json(tmp_path / "out.json", linear(tf), HEADER, time_bounds=(0.1, 10.0))
+    document = json.loads((tmp_path / "out.json").read_text())
+    assert document["samples"] is None and words in document["samples_omitted"]
+    assert len(document["knots"]["t"]) == 4  # the knots are still there
+
+
+def test_write_json_caps_the_sample_count_without_time_bounds(tmp_path):
+    write_json(tmp_path / "out.json", linear(4369.0), HEADER)  # 4.4 million samples at 1 ms
+    document = json.loads((tmp_path / "out.json").read_text())
+    assert document["samples"] is None and "more than 100000 samples" in document["samples_omitted"]
+    assert (tmp_path / "out.json").stat().st_size < 10_000
+
+
+def test_write_json_samples_a_tf_within_one_percent_of_its_bounds(tmp_path):
+    write_json(tmp_path / "out.json", linear(10.05), HEADER, time_bounds=(0.1, 10.0), dt=0.01)
+    document = json.loads((tmp_path / "out.json").read_text())
+    assert "samples_omitted" not in document and document["samples"]["t"][-1] == 10.05

@@ -74,3 +74,45 @@ def test_wrong_goal_fails_boundary():
 def test_motion_time_outside_the_time_bounds_fails_without_sampling(tf):
     verification = verify(PROBLEM, quintic(PROBLEM, tf))  # 3e11 s at 1 ms would be 2 PiB of samples
     assert [c.name for c in verification.checks] == ["motion_time"] and not verification.ok
+
+
+def scaled(trajectory: Trajectory, field: str, factor: float) -> Trajectory:
+    """`trajectory` with one sampled field multiplied by `factor` (an inconsistent set of samples)."""
+    def at(t: np.ndarray) -> Samples:
+        samples = trajectory.interpolant(t)
+        return dataclasses.replace(samples, **{field: factor * getattr(samples, field)})
+
+    return Trajectory(at(trajectory.knots.t), at)
+
+
+def test_a_consistent_motion_passes_both_consistency_checks():
+    checks = by_name(verify(PROBLEM, quintic(PROBLEM, 4.0)))
+    assert checks["qd_consistency"].worst < 1e-4 and checks["qdd_consistency"].worst < 1e-4
+
+
+@pytest.mark.parametrize("field, check", [("qd", "qd_consistency"), ("qdd", "qdd_consistency")])
+def test_a_derivative_that_is_not_the_derivative_fails_consistency(field, check):
+    checks = by_name(verify(PROBLEM, scaled(quintic(PROBLEM, 4.0), field, 1.1)))
+    assert not checks[check].ok
+    other = {"qd_consistency", "qdd_consistency"} - {check}
+    assert field == "qd" or checks[other.pop()].ok  # scaling qdd leaves q against qd consistent
+
+
+def test_a_jump_in_acceleration_is_consistent():
+    """Bang-bang in one joint (q̈ = ±a, switching at a time between samples), as TOPP-RA's timing makes."""
+    tf, a = 2.0005, 0.2  # the switch at 1.00025 s lies between samples
+
+    def at(t: np.ndarray) -> Samples:
+        t = np.asarray(t, dtype=float)
+        first = t <= tf / 2
+        late = tf - t
+        q1 = np.where(first, a * t**2 / 2, a * tf**2 / 4 - a * late**2 / 2)
+        q = np.tile(PROBLEM.start, (len(t), 1))
+        q[:, 0] += q1
+        qd, qdd = np.zeros_like(q), np.zeros_like(q)
+        qd[:, 0] = np.where(first, a * t, a * late)
+        qdd[:, 0] = np.where(first, a, -a)
+        return Samples(t, q, qd, qdd, np.zeros_like(q), np.zeros_like(q))
+
+    checks = by_name(verify(PROBLEM, Trajectory(at(np.array([0.0, 1.0005, tf])), at)))
+    assert checks["qd_consistency"].ok and checks["qdd_consistency"].worst < 1e-9

@@ -325,10 +325,15 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     `margin` (m): clearance kept while planning, lowered to the start's or goal's clearance if that is smaller.
 
     Status: "verified" or "violated" (dense `verify`), "no_path" (OMPL found no exact path in its budget) or
-    "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start."""
+    "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start (`Plan.found`
+    False). When the goal is the start, the path has length zero: the plan is to hold still at the start for
+    time.min seconds, verified like any other motion, without calling OMPL or TOPP-RA."""
     if planner_name not in OMPL_PLANNERS:
         raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
     began = time.perf_counter()
+    method = {"planner": "ompl-toppra", "path_planner": planner_name, "grid_points": grid_points}
+    if np.array_equal(problem.start, problem.goal):
+        return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
     setup = _import_backends()
     ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
     free = FreeSpace(problem, min(margin, float(ends.min())))
@@ -336,13 +341,14 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
              "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,
              "margin_m": free.margin}
-    method = {"planner": "ompl-toppra", "path_planner": planner_name, "grid_points": grid_points}
 
-    def done(trajectory: Trajectory, stopped: str | None, message: str) -> Plan:
-        return finish(problem, trajectory, stopped, method, began, setup_time=setup, message=message, extra=extra)
+    def done(trajectory: Trajectory, stopped: str | None, message: str, found: bool = True) -> Plan:
+        return finish(problem, trajectory, stopped, method, began, setup_time=setup, message=message, extra=extra,
+                      found=found)
 
     if found.waypoints is None:
-        return done(_hold(problem), "no_path", f"{planner_name}: no exact path within the budget")
+        return done(_hold(problem), "no_path", f"{planner_name}: no exact path within {planning_time:g} s "
+                    f"({free.checks} validity checks); no trajectory: the plan holds the start", found=False)
     smoothing = time.perf_counter()
     path, rounds = _smooth_path(found.waypoints, free, resolution)
     timing = time.perf_counter()
@@ -350,7 +356,8 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     extra.update(smooth_time_s=timing - smoothing, toppra_time_s=time.perf_counter() - timing,
                  validity_checks=free.checks, waypoints=len(path.ss_waypoints), repair_rounds=rounds)
     if timed is None:
-        return done(_hold(problem), "infeasible", "TOPP-RA: the path cannot be timed within the limits")
+        return done(_hold(problem), "infeasible", "TOPP-RA: the path cannot be timed within the limits; no "
+                    "trajectory: the plan holds the start", found=False)
     motion, knot_times = timed
     interpolant = _TimedPath(motion, problem.robot, problem.robot.model.createData())
     message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; "

@@ -1,11 +1,15 @@
-"""What every benchmark shares: measuring plans, loading a folder of scenarios, writing CSV, naming the machine."""
+"""What every benchmark shares: measuring plans, loading a folder of scenarios, writing CSV (at once, or row by row
+so that an interrupted benchmark can resume), naming the machine."""
 
 from __future__ import annotations
 
 import csv
+import io
 import os
 import platform
 import statistics
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -13,7 +17,7 @@ from ocpkit.errors import ScenarioError
 from ocpkit.plan import Plan
 from ocpkit.planner import plan
 from ocpkit.problem import Problem
-from ocpkit.report import RESULT_COLUMNS
+from ocpkit.report import RESULT_COLUMNS, row_key
 from ocpkit.scenario import load_scenario
 
 
@@ -47,6 +51,63 @@ def write_csv(path: Path, rows: list[dict], columns: tuple[str, ...] = RESULT_CO
         writer = csv.DictWriter(handle, fieldnames=columns)
         writer.writeheader()
         writer.writerows(rows)
+
+
+class Results:
+    """A results.csv that keeps every finished row: each row is appended as one complete, flushed and fsynced
+    line when it is added. Rows already in the file (a complete row with this file's columns) are kept, and
+    `row` does not plan their key again: a re-run with the same file resumes."""
+
+    def __init__(self, path: Path, columns: tuple[str, ...] = RESULT_COLUMNS) -> None:
+        self.path, self.columns = Path(path), columns
+        self.rows = self._complete_rows()
+        self.resumed = len(self.rows)
+        self._done = {row_key(r): r for r in self.rows}
+        write_csv(self.path.with_name(self.path.name + ".tmp"), self.rows, columns)
+        os.replace(self.path.with_name(self.path.name + ".tmp"), self.path)
+
+    def _complete_rows(self) -> list[dict]:
+        """The rows of the file with a value in every column (a line cut short by a crash is dropped)."""
+        if not self.path.exists():
+            return []
+        with self.path.open(newline="") as handle:
+            return [r for r in csv.DictReader(handle) if all(r.get(c) is not None for c in self.columns)]
+
+    def row(self, key: tuple[str, ...], measure_row: Callable[[], dict]) -> dict:
+        """The row with `key` (row_key), from the file if it is there, else `measure_row()` appended now."""
+        if key not in self._done:
+            self.add(measure_row())
+        return self._done[key]
+
+    def add(self, row: dict) -> None:
+        """Append `row` to the file as one complete line, flushed to disk."""
+        line = io.StringIO()
+        csv.DictWriter(line, fieldnames=self.columns).writerow(row)
+        with self.path.open("a", newline="") as handle:
+            handle.write(line.getvalue())
+            handle.flush()
+            os.fsync(handle.fileno())
+        self.rows.append(row)
+        self._done[row_key(row)] = row
+
+
+@contextmanager
+def reported_on_interrupt(results: Results) -> Iterator[None]:
+    """On Ctrl-C inside, print what `results` kept and how to resume, then let the KeyboardInterrupt go on."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        print(f"interrupted: {len(results.rows)} finished rows kept in {results.path.resolve()}; run the same "
+              "command again to resume", flush=True)
+        raise
+
+
+def resumed_line(results: Results) -> str:
+    """The line saying how many rows a resumed run keeps from an earlier one ('' if none)."""
+    if not results.resumed:
+        return ""
+    return (f"resuming: {results.resumed} rows already in {results.path.resolve()} are kept and not run again "
+            "(delete the file to start afresh)")
 
 
 def cpu_name() -> str:

@@ -10,12 +10,20 @@ from __future__ import annotations
 
 import dataclasses
 import statistics
+from dataclasses import dataclass
 from pathlib import Path
 
-from ocpkit.bench.common import load_all, machine, measure, write_csv
+from ocpkit.bench.common import (
+    Results,
+    load_all,
+    machine,
+    measure,
+    reported_on_interrupt,
+    resumed_line,
+)
 from ocpkit.plan import Plan
 from ocpkit.problem import Problem
-from ocpkit.report import result_row, trajectory_header
+from ocpkit.report import Recorded, result_row, row_key, trajectory_header
 from ocpkit.trajectory import write_json
 
 PAPER_TF = {12: [1.65, 1.23, 1.05, 1.08], 8: [1.98, 1.23, 1.09, 1.11]}
@@ -32,41 +40,70 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
     """Solve every case at every knot count with every dynamics form and with the baseline; print the
     tables; write results.csv and trajectories/. With `hard` (a folder of scenarios), also compare the
     straight-line and the OMPL initial guess on the paper cases and those. The simultaneous planner uses
-    `transcription` (with `transcription_options`); the single-knot-count comparisons use knots[0]."""
+    `transcription` (with `transcription_options`); the single-knot-count comparisons use knots[0].
+
+    Each row is added to results.csv as its plan finishes; rows already there (suite, case and method) are not
+    run again, so a run stopped by Ctrl-C resumes where it stopped. The tables show every row, earlier or new."""
     problems = load_all(Path(scenarios))
-    method = {"transcription": transcription, "transcription_options": transcription_options or {}}
-    rows, simultaneous, baseline = [], {}, {}
-    for form in dynamics:
-        for n in knots:
-            for problem in problems:
-                m = measure(problem, repeats, knots=n, dynamics=form, **method)
-                simultaneous[form, problem.name, n] = m
-                rows.append(result_row("paper", problem.name, m.plan, m.solve_time, m.setup_time))
-                if form == dynamics[0]:
-                    _write_trajectory(out, problem, m.plan)
-    for problem in problems:
-        m = baseline[problem.name] = measure(problem, repeats, planner="ompl-toppra")
-        rows.append(result_row("paper", problem.name, m.plan, m.solve_time, m.setup_time))
-        _write_trajectory(out, problem, m.plan)
-    for problem in _matched_to_baseline(problems):
-        m = simultaneous["matched", problem.name, knots[0]] = measure(problem, 1, knots=knots[0],
-                                                                      dynamics=dynamics[0], **method)
-        rows.append(result_row("matched-to-baseline", problem.name, m.plan, m.solve_time, m.setup_time))
+    results = Results(Path(out) / "results.csv")
+    if results.resumed:
+        print(resumed_line(results), flush=True)
+    bench = _Bench(results, Path(out), repeats, transcription, transcription_options or {})
+    with reported_on_interrupt(results):
+        simultaneous = {(form, p.name, n): bench.simultaneous("paper", p, n, form, write=form == dynamics[0])
+                        for form in dynamics for n in knots for p in problems}
+        baseline = {p.name: bench.baseline(p) for p in problems}
+        matched = {p.name: bench.simultaneous("matched-to-baseline", p, knots[0], dynamics[0], repeats=1)
+                   for p in _matched_to_baseline(problems)}
+        seeding = bench.seeding(problems + load_all(Path(hard)), knots[0], dynamics[0]) if hard is not None else {}
     first = {(c, k): m for (f, c, k), m in simultaneous.items() if f == dynamics[0]}
-    options = "".join(f" {k}={v}" for k, v in method["transcription_options"].items())
+    options = "".join(f" {k}={v}" for k, v in bench.options.items())
     print(_paper_table(problems, first, f"{transcription}{options} + ipopt, dynamics {dynamics[0]}", knots))
     print(_comparison(problems, simultaneous, dynamics, knots))
-    matched = {c: m for (f, c, k), m in simultaneous.items() if f == "matched"}
     print(_baseline_table(problems, {c: m for (c, k), m in first.items() if k == knots[0]}, baseline, matched))
     if hard is not None:
-        seeding = {(p.name, guess): measure(p, 1, knots=knots[0], dynamics=dynamics[0], guess=guess, **method)
-                   for p in problems + load_all(Path(hard)) for guess in ("line", "ompl")}
-        rows += [result_row(f"seeding-{guess}", name, m.plan, m.solve_time, m.setup_time)
-                 for (name, guess), m in seeding.items()]
         print(_seeding_table(seeding))
-    write_csv(out / "results.csv", rows)
     print(f"{machine()}; computation times are medians of {repeats} runs per plan (seeding: 1 run)")
-    return rows
+    print(f"results: {results.path.resolve()} and {(Path(out) / 'trajectories').resolve()}/")
+    return results.rows
+
+
+@dataclass(frozen=True)
+class _Bench:
+    """How the paper bench plans: each (suite, case, method) once into `results`, trajectories under `out`."""
+
+    results: Results
+    out: Path
+    repeats: int
+    transcription: str
+    options: dict
+
+    def simultaneous(self, suite: str, problem: Problem, knots: int, dynamics: str, write: bool = False,
+                     repeats: int | None = None, **options) -> Recorded:
+        """The simultaneous planner's row for `problem` at `knots` with `dynamics` (and `options`)."""
+        method = {"planner": "simultaneous", "transcription": self.transcription, "knots": knots, "solver": "ipopt",
+                  "dynamics": dynamics}
+        return self._row(suite, problem, method, write, self.repeats if repeats is None else repeats,
+                         transcription=self.transcription, transcription_options=self.options, knots=knots,
+                         dynamics=dynamics, **options)
+
+    def seeding(self, problems: list[Problem], knots: int, dynamics: str) -> dict[tuple[str, str], Recorded]:
+        """The straight-line and the OMPL guess on each of `problems`, one run each, by (case, guess)."""
+        return {(p.name, guess): self.simultaneous(f"seeding-{guess}", p, knots, dynamics, repeats=1, guess=guess)
+                for p in problems for guess in ("line", "ompl")}
+
+    def baseline(self, problem: Problem) -> Recorded:
+        """The OMPL + TOPP-RA baseline's row for `problem`."""
+        return self._row("paper", problem, {"planner": "ompl-toppra"}, True, self.repeats, planner="ompl-toppra")
+
+    def _row(self, suite: str, problem: Problem, method: dict, write: bool, repeats: int, **options) -> Recorded:
+        def measured() -> dict:
+            m = measure(problem, repeats, **options)
+            if write:
+                _write_trajectory(self.out, problem, m.plan)
+            return result_row(suite, problem.name, m.plan, m.solve_time, m.setup_time)
+
+        return Recorded.of(self.results.row(row_key({"suite": suite, "case": problem.name, **method}), measured))
 
 
 def _matched_to_baseline(problems: list[Problem]) -> list[Problem]:
@@ -88,7 +125,7 @@ def _paper_table(problems: list[Problem], measured: dict, label: str, counts: tu
     head = f"{'time [s]':<20}{'knots':>6}" + "".join(f"{p.name:>{WIDTH}}" for p in problems)
     lines = [f"Table II, simultaneous planner ({label}): ours (paper) [velocity lower bound]", head, "-" * len(head)]
     for knots in counts:
-        cells = [f"{measured[p.name, knots].plan.trajectory.tf:.2f} {_paper(PAPER_TF, knots, k)} "
+        cells = [f"{measured[p.name, knots].tf:.2f} {_paper(PAPER_TF, knots, k)} "
                  f"[{p.velocity_lower_bound():.2f}]" for k, p in enumerate(problems)]
         lines.append(_row("motion time t_f", knots, cells))
     for knots in counts:
@@ -96,7 +133,7 @@ def _paper_table(problems: list[Problem], measured: dict, label: str, counts: tu
                  for k, p in enumerate(problems)]
         lines.append(_row("computation time", knots, cells))
     for knots in counts:
-        lines.append(_row("status", knots, [measured[p.name, knots].plan.status for p in problems]))
+        lines.append(_row("status", knots, [measured[p.name, knots].status for p in problems]))
     return "\n".join(lines)
 
 
@@ -115,7 +152,7 @@ def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ..
             median = statistics.median(m.solve_time for m in cases)
             setup = max(m.setup_time for m in cases)
             speedup = f"{statistics.median(PAPER_SOLVE[knots]) / median:.1f}x" if knots in PAPER_SOLVE else "-"
-            verified = sum(m.plan.ok for m in cases)
+            verified = sum(m.ok for m in cases)
             lines.append(f"{form:<14}{knots:>6}{median:>19.3f}s{speedup:>10}{setup:>8.2f}s{PAPER_SETUP:>13.1f}s"
                          f"{verified:>8}/{len(cases)}")
     return "\n".join(lines)
@@ -125,25 +162,25 @@ def _baseline_table(problems: list[Problem], simultaneous: dict, baseline: dict,
     head = f"{'':<26}" + "".join(f"{p.name:>{WIDTH}}" for p in problems)
     lines = ["", "Path-velocity decomposition baseline (OMPL RRTConnect + TOPP-RA), same problems, same verify",
              head, "-" * len(head)]
-    stat = lambda key: [baseline[p.name].plan.stats.extra.get(key, 0.0) for p in problems]  # noqa: E731
+    stat = lambda key: [baseline[p.name].extra.get(key, 0.0) for p in problems]  # noqa: E731
     cells = {
-        "t_f baseline": [f"{baseline[p.name].plan.trajectory.tf:.3f}" for p in problems],
-        "t_f simultaneous": [f"{simultaneous[p.name].plan.trajectory.tf:.3f}" for p in problems],
-        "ratio sim / baseline": [f"{simultaneous[p.name].plan.trajectory.tf / baseline[p.name].plan.trajectory.tf:.3f}"
+        "t_f baseline": [f"{baseline[p.name].tf:.3f}" for p in problems],
+        "t_f simultaneous": [f"{simultaneous[p.name].tf:.3f}" for p in problems],
+        "ratio sim / baseline": [f"{simultaneous[p.name].tf / baseline[p.name].tf:.3f}"
                                  for p in problems],
-        "t_f sim, matched": [f"{matched[p.name].plan.trajectory.tf:.3f} {matched[p.name].plan.status[:3]}"
+        "t_f sim, matched": [f"{matched[p.name].tf:.3f} {matched[p.name].status[:3]}"
                              for p in problems],
-        "ratio matched / baseline": [f"{matched[p.name].plan.trajectory.tf / baseline[p.name].plan.trajectory.tf:.3f}"
+        "ratio matched / baseline": [f"{matched[p.name].tf / baseline[p.name].tf:.3f}"
                                      for p in problems],
         "computation [s]": [f"{baseline[p.name].solve_time:.3f}" for p in problems],
         "  path + simplify [s]": [f"{a + b:.3f}" for a, b in zip(stat("path_time_s"), stat("simplify_time_s"))],
         "  smoothing [s]": [f"{t:.3f}" for t in stat("smooth_time_s")],
         "  TOPP-RA [s]": [f"{t:.3f}" for t in stat("toppra_time_s")],
-        "status": [baseline[p.name].plan.status for p in problems],
+        "status": [baseline[p.name].status for p in problems],
     }
     lines += [f"{label:<26}" + "".join(f"{c:>{WIDTH}}" for c in row) for label, row in cells.items()]
     for p in problems:
-        lines.append(f"  {p.name} baseline checks: {baseline[p.name].plan.verification.summary()}")
+        lines.append(f"  {p.name} baseline checks: {baseline[p.name].checks}")
     lines.append("  matched: the simultaneous planner given only what TOPP-RA enforces (torque-rate limits x1000, "
                  "mu = 0.001), verified against those relaxed limits")
     return "\n".join(lines)
@@ -154,8 +191,8 @@ def _seeding_table(seeding: dict) -> str:
              "(the baseline's time included)", f"{'case':<12}{'guess':<7}{'status':>12}{'t_f':>8}{'time [s]':>10}"
              f"{'iterations':>12}"]
     for (name, guess), m in seeding.items():
-        lines.append(f"{name:<12}{guess:<7}{m.plan.status:>12}{m.plan.trajectory.tf:>8.3f}{m.solve_time:>10.2f}"
-                     f"{m.plan.stats.iterations:>12}")
+        lines.append(f"{name:<12}{guess:<7}{m.status:>12}{m.tf:>8.3f}{m.solve_time:>10.2f}"
+                     f"{m.iterations:>12}")
     return "\n".join(lines)
 
 

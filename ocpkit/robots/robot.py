@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+import functools
 import hashlib
+import itertools
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
-import yaml
 
-from ocpkit.errors import RobotError
+from ocpkit.errors import RobotError, within
 from ocpkit.robots.friction import friction_slope, friction_torque
+from ocpkit.robots.urdf import model_from_urdf
+from ocpkit.schema import ROBOT, SPEC, check, read_yaml, show
 
 DATA_DIR = Path(__file__).parent / "data"
 
@@ -67,15 +70,14 @@ def builtin_robots() -> list[str]:
 
 def load_robot(robot: str | dict[str, Any], base_dir: Path | None = None) -> Robot:
     """Load a built-in robot by name, or `{urdf: path, spec: path}` (relative paths start at base_dir)."""
-    if isinstance(robot, str):
-        folder = DATA_DIR / robot
-        if not (folder / "spec.yaml").exists():
-            raise RobotError(f"unknown robot {robot!r}; built-in robots: {', '.join(builtin_robots())}")
-        return robot_from_files(folder / "robot.urdf", folder / "spec.yaml")
-    if isinstance(robot, dict) and set(robot) == {"urdf", "spec"}:
+    check(robot, ROBOT, RobotError, "robot")
+    if isinstance(robot, dict):
         base = base_dir or Path.cwd()
         return robot_from_files(base / robot["urdf"], base / robot["spec"])
-    raise RobotError(f"robot must be a built-in name or {{urdf: ..., spec: ...}}, got {robot!r}")
+    if robot not in builtin_robots():
+        raise RobotError(f"unknown robot {show(robot)}; built-in robots: {', '.join(builtin_robots())}; "
+                         "a robot of your own is {urdf: path, spec: path}")
+    return robot_from_files(DATA_DIR / robot / "robot.urdf", DATA_DIR / robot / "spec.yaml")
 
 
 CACHE_SIZE = 16
@@ -84,7 +86,7 @@ _BY_KEY: dict[str, Robot] = {}
 
 
 def robot_from_files(urdf: Path, spec_file: Path) -> Robot:
-    """Build a Robot from a URDF and a spec.yaml (schema in README, section 'Robot files').
+    """Build a Robot from a URDF and a spec.yaml (README, section 'Robot files'; ocpkit.schema.SPEC).
 
     Both files are read anew on every call; identical content gives the same Robot object (a bounded cache by
     content key), so problems on one robot share one Robot and its builds, and an edited file a new Robot."""
@@ -107,7 +109,10 @@ def _content_key(urdf: bytes, spec: bytes) -> str:
 def _read(path: Path) -> bytes:
     if not path.is_file():
         raise RobotError(f"robot file not found: {path}")
-    return path.read_bytes()
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise RobotError(f"cannot read robot file {path}: {exc.strerror}") from exc
 
 
 def _remember(robot: Robot) -> None:
@@ -119,71 +124,79 @@ def _remember(robot: Robot) -> None:
 
 def _build(urdf_bytes: bytes, spec_bytes: bytes, key: str, urdf: Path, spec_file: Path) -> Robot:
     """The Robot of these file contents; the paths only name the files in error messages."""
-    try:
-        spec = yaml.safe_load(spec_bytes)
-        full = pin.buildModelFromXML(urdf_bytes.decode())
-    except (yaml.YAMLError, UnicodeDecodeError, ValueError, RuntimeError) as exc:
-        raise RobotError(f"cannot read robot files {urdf}, {spec_file}: {exc}") from exc
-    return _robot_from_spec(full, spec, key, spec_file)
+    full = model_from_urdf(urdf_bytes, urdf)
+    with within(spec_file):
+        spec = read_yaml(spec_bytes, RobotError)
+        check(spec, SPEC, RobotError)
+        return _robot_from_spec(full, spec, key)
 
 
-def _vector(spec: dict, path: str, n: int, spec_file: Path) -> np.ndarray:
+def _vector(spec: dict, path: str, n: int) -> np.ndarray:
+    """The (n,) array at dotted `path` of a schema-checked spec."""
     value: Any = spec
     for key in path.split("."):
-        if not isinstance(value, dict) or key not in value:
-            raise RobotError(f"{spec_file}: missing '{path}'")
         value = value[key]
-    array = np.asarray(value, dtype=float)
-    if array.shape != (n,):
-        raise RobotError(f"{spec_file}: '{path}' needs {n} values, got {np.shape(array)}")
-    return array
+    if len(value) != n:
+        raise RobotError(f"'{path}' needs {n} values, one per joint, got {len(value)}: {show(value)}")
+    return np.asarray(value, dtype=float)
 
 
-def _robot_from_spec(full: pin.Model, spec: dict, key: str, spec_file: Path) -> Robot:
-    if not isinstance(spec, dict) or "joints" not in spec or "name" not in spec:
-        raise RobotError(f"{spec_file}: needs at least 'name' and 'joints'")
+def _robot_from_spec(full: pin.Model, spec: dict, key: str) -> Robot:
+    """The Robot of a schema-checked spec on the URDF's model `full`."""
     joints = tuple(spec["joints"])
-    missing = [j for j in joints if not full.existJointName(j)]
-    if missing:
-        raise RobotError(f"{spec_file}: joints not in the URDF: {missing}")
-    keep = [full.getJointId(j) for j in joints]
-    if keep != sorted(keep):
-        raise RobotError(f"{spec_file}: 'joints' must follow the URDF tree order {list(full.names[1:])}")
-    locked = [j for j in range(1, full.njoints) if j not in keep]
-    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    model = _reduced_model(full, joints)
     n = len(joints)
-    if model.nq != n or model.nv != n:
-        raise RobotError(f"{spec_file}: only 1-DoF joints are supported (nq={model.nq}, nv={model.nv})")
-    vec = lambda path: _vector(spec, path, n, spec_file)  # noqa: E731
-    joint_of, offset, radius, link = _spheres(model, spec.get("spheres", []), spec_file)
-    pairs = np.asarray(spec.get("self_collision", []), dtype=int).reshape(-1, 2)
-    if pairs.size and (pairs.min() < 0 or pairs.max() >= len(radius)):
-        raise RobotError(f"{spec_file}: self_collision index outside 0..{len(radius) - 1}")
-    smoothing = float(spec.get("friction", {}).get("smoothing", 0.0))
-    if smoothing <= 0:
-        raise RobotError(f"{spec_file}: friction.smoothing must be > 0 rad/s")
+    vec = functools.partial(_vector, spec, n=n)
+    joint_of, offset, radius, link = _spheres(model, spec.get("spheres", []))
     robot = Robot(
-        name=str(spec["name"]), key=key, model=model, joint_names=joints,
+        name=spec["name"], key=key, model=model, joint_names=joints,
         q_lower=vec("limits.position.lower"), q_upper=vec("limits.position.upper"),
         qd_max=vec("limits.velocity"), tau_max=vec("limits.torque"), taud_max=vec("limits.torque_rate"),
         gear_ratios=vec("gear_ratios"), viscous=vec("friction.viscous"), coulomb=vec("friction.coulomb"),
-        friction_smoothing=smoothing, sphere_joint=joint_of, sphere_offset=offset, sphere_radius=radius,
-        sphere_link=link, self_collision=pairs,
+        friction_smoothing=float(spec["friction"]["smoothing"]), sphere_joint=joint_of, sphere_offset=offset,
+        sphere_radius=radius, sphere_link=link, self_collision=_pairs(spec.get("self_collision", []), len(radius)),
     )
-    for field in ("qd_max", "tau_max", "taud_max", "gear_ratios"):
-        if np.any(getattr(robot, field) <= 0):
-            raise RobotError(f"{spec_file}: {field} must be positive")
-    if np.any(robot.q_lower >= robot.q_upper):
-        raise RobotError(f"{spec_file}: position lower limits must be below upper limits")
+    _check_position_limits(robot)
     return robot
 
 
-def _spheres(model: pin.Model, spheres: list, spec_file: Path):
+def _reduced_model(full: pin.Model, joints: tuple[str, ...]) -> pin.Model:
+    """`full` with every joint but `joints` (URDF names, in tree order) locked at its neutral position."""
+    missing = [j for j in joints if not full.existJointName(j)]
+    if missing:
+        raise RobotError(f"joints not in the URDF: {missing}")
+    keep = [full.getJointId(j) for j in joints]
+    if any(a >= b for a, b in itertools.pairwise(keep)):
+        raise RobotError(f"'joints' must follow the URDF tree order {list(full.names[1:])}, each joint once")
+    locked = [j for j in range(1, full.njoints) if j not in keep]
+    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    if model.nq != len(joints) or model.nv != len(joints):
+        raise RobotError(f"only 1-DoF joints are supported (nq={model.nq}, nv={model.nv})")
+    return model
+
+
+def _check_position_limits(robot: Robot) -> None:
+    for i in np.nonzero(robot.q_lower >= robot.q_upper)[0]:
+        raise RobotError(f"limits.position.lower[{i}] = {robot.q_lower[i]} must be below limits.position.upper[{i}] "
+                         f"= {robot.q_upper[i]} (joint {robot.joint_names[i]})")
+
+
+def _pairs(pairs: list[list[int]], count: int) -> np.ndarray:
+    """The (P, 2) index array of schema-checked self_collision pairs among `count` spheres."""
+    for k, (a, b) in enumerate(pairs):
+        if max(a, b) >= count or a == b:
+            raise RobotError(f"self_collision index outside the {count} spheres or a sphere paired with itself: "
+                             f"self_collision[{k}] = {show([a, b])}")
+    return np.asarray(pairs, dtype=int).reshape(-1, 2)
+
+
+def _spheres(model: pin.Model, spheres: list[dict]):
+    """Parent joint (M,), offset in that joint's frame (M, 3), radius (M,) and link name of schema-checked spheres."""
     joint_of, offset, radius, link = [], [], [], []
     for k, sphere in enumerate(spheres):
-        name = sphere.get("link")
+        name = sphere["link"]
         if not model.existFrame(name):
-            raise RobotError(f"{spec_file}: sphere {k} is on unknown link {name!r}")
+            raise RobotError(f"spheres[{k}] is on unknown link {show(name)}")
         frame = model.frames[model.getFrameId(name)]
         joint_of.append(frame.parentJoint)
         offset.append(frame.placement.act(np.asarray(sphere["center"], dtype=float)))

@@ -22,6 +22,16 @@ from ocpkit.nlp import NLP
 from ocpkit.registry import Registry
 
 
+BOUND_TOLERANCE = 1e-6
+"""How far, relative to max(ubx − lbx, 1), a solution may lie outside its variable bounds and count as inside."""
+
+
+def bound_slack(lbx: np.ndarray, ubx: np.ndarray) -> np.ndarray:
+    """How far each variable (n_w,) may lie outside [lbx, ubx] and still count as inside (BOUND_TOLERANCE)."""
+    width = np.where(np.isfinite(ubx - lbx), ubx - lbx, 1.0)
+    return BOUND_TOLERANCE * np.maximum(width, 1.0)
+
+
 class SolverStatus(str, Enum):
     """What happened in a solve."""
 
@@ -54,8 +64,12 @@ class PreparedSolver(ABC):
     nlp: NLP
 
     @abstractmethod
-    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
-        """Solve from `guess` (n_w,) with parameters `params` (n_p,) and variable bounds (lbx, ubx) (n_w,) each."""
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+              max_wall_time: float | None = None) -> SolverResult:
+        """Solve from `guess` (n_w,) with parameters `params` (n_p,) and variable bounds (lbx, ubx) (n_w,) each.
+
+        `max_wall_time` (s) replaces the solver's own limit for this call (None: the solver's); a solver that
+        cannot be interrupted reports an overrun as `time_limit` after the fact (its docstring says so)."""
 
 
 class Solver(ABC):
@@ -69,10 +83,10 @@ class Solver(ABC):
     def prepare(self, nlp: NLP) -> PreparedSolver:
         """The one-time set-up for `nlp`; OptionError when this solver cannot take it."""
 
-    def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray,
-              bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+    def solve(self, nlp: NLP, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+              max_wall_time: float | None = None) -> SolverResult:
         """One solve of `nlp` (prepared for this call only): see `PreparedSolver.solve`."""
-        return self.prepare(nlp).solve(guess, params, bounds)
+        return self.prepare(nlp).solve(guess, params, bounds, max_wall_time)
 
 
 SOLVERS: Registry[type] = Registry("solver", "ocpkit.solvers")

@@ -6,10 +6,14 @@ All share `CasadiNlpsol`: `prepare` creates the nlpsol of one NLP (a `PreparedNl
 mapping from `solver.stats()` (`success`, `return_status`, `iter_count`, `unified_return_status`), and a
 CasADi RuntimeError during a solve reported as status `failed` with its message instead of an exception.
 
-Time limits: IPOPT has its own `max_wall_time`; sqpmethod stops through CasADi's `iteration_callback`
-(checked once per SQP iteration, reported as `User_Requested_Stop`). blocksqp and fatrop ignore the
-iteration callback and have no wall-time option, so they cannot be interrupted: an unconverged solve that
-overran `max_wall_time` is reported as `time_limit` after the fact.
+Time limits: IPOPT and sqpmethod stop through CasADi's `iteration_callback` (`_Deadline`, checked once per
+iteration), at the solver's `max_wall_time` or the one passed to `PreparedSolver.solve` for that call. The same
+callback stops a diverging solve: an iterate beyond its variable bounds (lbx, ubx) by more than DIVERGED
+(relative to the bound's width, at least 1 in the variable's unit; sqpmethod after a failed QP can step outside
+and come back, so a small excursion is left to the check of the final iterate) is reported `failed` at once
+instead of running on. blocksqp and
+fatrop ignore the iteration callback and have no wall-time option, so they cannot be interrupted: an
+unconverged solve that overran its limit is reported as `time_limit` after the fact.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ import numpy as np
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP, Stages
-from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
+from ocpkit.solvers.base import BOUND_TOLERANCE, PreparedSolver, Solver, SolverResult, SolverStatus, bound_slack
 
 _UNIFIED_STATUS = {
     "SOLVER_RET_SUCCESS": SolverStatus.CONVERGED,
@@ -61,14 +65,26 @@ def _last_line(exc: Exception) -> str:
     return line.split(" failed: ", 1)[-1] if "Assertion" in line else line
 
 
+DIVERGED = 1.0
+"""An iterate this far beyond a bound (times the bound's width, at least 1) has diverged."""
+
+
 class _Deadline(ca.Callback):
-    """nlpsol iteration callback that asks the solver to stop once `deadline` (time.perf_counter s) passed."""
+    """nlpsol iteration callback that asks the solver to stop once the deadline (time.perf_counter s) has
+    passed or the iterate has left its bounds; `reason` ("deadline", "bounds" or "") says which."""
 
     def __init__(self, n_w: int, n_g: int, n_p: int) -> None:
         ca.Callback.__init__(self)
         self.sizes = {"x": n_w, "lam_x": n_w, "g": n_g, "lam_g": n_g, "lam_p": n_p, "f": 1}
-        self.deadline = np.inf
+        self.arm(np.inf, np.full(n_w, -np.inf), np.full(n_w, np.inf))
         self.construct("deadline", {})
+
+    def arm(self, deadline: float, lbx: np.ndarray, ubx: np.ndarray) -> None:
+        """Watch one solve: stop at `deadline` (time.perf_counter s) or when the iterate has diverged from
+        [lbx, ubx] (n_w,) (module docstring)."""
+        self.deadline, self.reason = deadline, ""
+        slack = DIVERGED * bound_slack(lbx, ubx) / BOUND_TOLERANCE
+        self.lower, self.upper = lbx - slack, ubx + slack
 
     def get_n_in(self) -> int:
         return ca.nlpsol_n_out()
@@ -86,7 +102,17 @@ class _Deadline(ca.Callback):
         return ca.Sparsity.dense(self.sizes[ca.nlpsol_out(i)], 1)
 
     def eval(self, arg: list) -> list:
-        return [1 if time.perf_counter() > self.deadline else 0]
+        x = np.asarray(arg[0]).ravel()
+        if not np.all((x >= self.lower) & (x <= self.upper)):
+            self.reason = "bounds"
+        elif time.perf_counter() > self.deadline:
+            self.reason = "deadline"
+        return [1 if self.reason else 0]
+
+
+_STOPPED = {"deadline": SolverStatus.TIME_LIMIT, "bounds": SolverStatus.FAILED}
+"""Our status when the `_Deadline` callback stopped the solve, by its reason."""
+_STOP_MESSAGES = {"deadline": "stopped at the wall-time limit", "bounds": "stopped: iterate outside its bounds"}
 
 
 @dataclass(frozen=True)
@@ -99,22 +125,27 @@ class PreparedNlpsol(PreparedSolver):
     deadline: _Deadline | None
     owner: CasadiNlpsol
 
-    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+              max_wall_time: float | None = None) -> SolverResult:
+        """See `PreparedSolver.solve`; blocksqp and fatrop cannot be stopped at `max_wall_time` (module docstring)."""
         start = time.perf_counter()
+        limit = self.owner.max_wall_time if max_wall_time is None else max_wall_time
         if self.deadline is not None:
-            self.deadline.deadline = start + self.owner.max_wall_time
+            self.deadline.arm(start + limit, *(np.asarray(b, dtype=float) for b in bounds))
         try:
             with _silenced_stdout():
-                out = self.function(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=self.nlp.lbg,
-                                    ubg=self.nlp.ubg)
+                out = self.function(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1],
+                                    lbg=self.nlp.lbg, ubg=self.nlp.ubg)
             stats = self.function.stats()
         except RuntimeError as exc:  # a plugin's assertion or failed evaluation: a status, not a crash
             return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
                                 time.perf_counter() - start, str(exc))
         wall = time.perf_counter() - start
         message = str(stats.get("return_status", stats.get("unified_return_status", "unknown")))
-        return SolverResult(np.asarray(out["x"]).ravel(), self.owner.status(stats, message, wall),
-                            self.owner.iterations(stats), wall, message, stats,
+        stopped = self.deadline.reason if self.deadline is not None else ""
+        status = _STOPPED.get(stopped) or self.owner.status(stats, message, wall > limit)
+        return SolverResult(np.asarray(out["x"]).ravel(), status, self.owner.iterations(stats), wall,
+                            _STOP_MESSAGES.get(stopped, message), stats,
                             np.asarray(out["lam_g"]).ravel(), np.asarray(out["lam_x"]).ravel())
 
 
@@ -152,13 +183,14 @@ class CasadiNlpsol(Solver):
         """Iterations the plugin took, from its stats."""
         return int(stats.get("iter_count") or 0)
 
-    def status(self, stats: dict, message: str, wall: float) -> SolverStatus:
-        """Our status from the plugin's stats: its own table, then CasADi's unified status and the limits."""
+    def status(self, stats: dict, message: str, overran: bool) -> SolverStatus:
+        """Our status from the plugin's stats: its own table, then CasADi's unified status and the limits
+        (`overran`: the solve took longer than its wall-time limit)."""
         if message in self.statuses:
             return self.statuses[message]
         if stats.get("success"):
             return SolverStatus.CONVERGED
-        if wall > self.max_wall_time:
+        if overran:
             return SolverStatus.TIME_LIMIT
         if self.iterations(stats) >= self.max_iterations:
             return SolverStatus.ITERATION_LIMIT
@@ -178,12 +210,12 @@ class Ipopt(CasadiNlpsol):
         "Maximum_WallTime_Exceeded": SolverStatus.TIME_LIMIT,
         "Maximum_CpuTime_Exceeded": SolverStatus.TIME_LIMIT,
     }
+    stops_by_callback = True  # the wall-time limit, per call (module docstring)
 
     def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, **ipopt_options) -> None:
         super().__init__(max_iterations, max_wall_time)
         self.options = {"linear_solver": "mumps", "print_level": 0, "sb": "yes", "tol": 1e-6,
-                        "mu_strategy": "adaptive", "max_iter": max_iterations, "max_wall_time": max_wall_time,
-                        **ipopt_options}
+                        "mu_strategy": "adaptive", "max_iter": max_iterations, **ipopt_options}
 
     def plugin_options(self, nlp: NLP) -> dict:
         return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}}
@@ -203,14 +235,15 @@ class SqpMethod(CasadiNlpsol):
     `convexify_strategy` ("regularize", "eigen-clip", "eigen-reflect") convexifies the Lagrangian Hessian:
     off (None) by default, as the paper cases converge without it, "regularize" stalls case 2 at the
     iteration limit and "eigen-clip" with osqp fails in the first QP. The time limit is checked between SQP
-    iterations, so one long QP (qpoases' first, cold-started) can overrun it. Extra keyword options go to
+    iterations, so one long QP (qpoases' first, cold-started, or one on a diverging iterate: 5–25 s on an
+    industrial6 problem at 12 knots) can overrun it; an iterate that leaves its bounds (after a failed QP) stops
+    the solve at once (module docstring). Extra keyword options go to
     sqpmethod verbatim."""
 
     name = plugin = "sqpmethod"
     statuses = {
         "Solve_Succeeded": SolverStatus.CONVERGED,
         "Maximum_Iterations_Exceeded": SolverStatus.ITERATION_LIMIT,
-        "User_Requested_Stop": SolverStatus.TIME_LIMIT,  # only our deadline callback stops it
     }
     stops_by_callback = True
 

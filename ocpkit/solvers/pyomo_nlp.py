@@ -264,13 +264,16 @@ class PreparedRipopt(PreparedSolver):
     translation: _PyomoNlp
     owner: PyomoRipopt
 
-    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+              max_wall_time: float | None = None) -> SolverResult:
         guess = np.asarray(guess, dtype=float)
         self.translation.load(guess, np.asarray(params, dtype=float), *(np.asarray(b, dtype=float) for b in bounds))
-        options = {"hessian_approximation": hessian_approximation(self.nlp), **self.owner.options}
+        limit = self.owner.max_wall_time if max_wall_time is None else max_wall_time
+        options = {"hessian_approximation": hessian_approximation(self.nlp), **self.owner.options,
+                   "max_wall_time": limit}
         start = time.perf_counter()
         try:
-            results, log = self.owner.run(self.translation.model, options)
+            results, log = self.owner.run(self.translation.model, options, limit)
         except subprocess.TimeoutExpired:
             wall = time.perf_counter() - start
             return SolverResult(guess, SolverStatus.TIME_LIMIT, 0, wall, f"ripopt killed after {wall:.1f} s")
@@ -306,14 +309,14 @@ class PyomoRipopt(Solver):
                               "or a CasADi solver such as ipopt instead")
         return PreparedRipopt(nlp, _PyomoNlp(nlp, self.lift_above), self)
 
-    def run(self, model: pyo.ConcreteModel, options: dict) -> tuple[SolverResults, str]:
+    def run(self, model: pyo.ConcreteModel, options: dict, max_wall_time: float) -> tuple[SolverResults, str]:
         """Solve `model` with ripopt quietly; (Pyomo's results, ripopt's output). The solution is loaded
         into the model unless ripopt reports an error status. ripopt is killed (subprocess.TimeoutExpired)
-        once it overruns `max_wall_time` by max(1 s, 1 %). Temporary files are removed on return."""
+        once it overruns `max_wall_time` (s) by max(1 s, 1 %). Temporary files are removed on return."""
         with LoggingIntercept(io.StringIO(), "pyomo"), TempfileManager as tempfiles:
             log = tempfiles.create_tempfile(suffix="_ripopt.log")
             results = self._ripopt.solve(model, options=options, logfile=log, load_solutions=False,
-                                         timelimit=self.max_wall_time)
+                                         timelimit=max_wall_time)
             if results.solver.status in _LOADED:
                 model.solutions.load_from(results)
             with open(log, encoding="utf-8") as output:

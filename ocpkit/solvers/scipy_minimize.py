@@ -8,8 +8,8 @@ form z (n_z,) = w[free]. Constraints lbg ≤ g ≤ ubg split into equalities (lb
 sides of the rest.
 
 Limits: `max_iterations` is SciPy's `maxiter`; the time limit is checked by the per-iteration callback,
-which raises StopIteration once `max_wall_time` (s) has passed (SciPy then ends with status 99 for SLSQP,
-3 for trust-constr), so it is honoured to within one iteration.
+which raises StopIteration once `max_wall_time` (s; or the one passed to `solve`) has passed (SciPy then ends
+with status 99 for SLSQP, 3 for trust-constr), so it is honoured to within one iteration.
 """
 
 from __future__ import annotations
@@ -85,7 +85,8 @@ class PreparedMinimize(PreparedSolver):
     functions: NLPFunctions
     owner: ScipyMinimize
 
-    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+              max_wall_time: float | None = None) -> SolverResult:
         owner = self.owner
         lbx, ubx = (np.asarray(b, dtype=float) for b in bounds)
         reduced = _Reduced(self.functions, np.asarray(params, dtype=float), lbx, ubx)
@@ -97,7 +98,7 @@ class PreparedMinimize(PreparedSolver):
                                  hess=reduced.objective_hessian() if owner.hessians else None,
                                  bounds=so.Bounds(lbx[free], ubx[free]),
                                  constraints=owner.constraints(self.nlp, reduced), options=owner.options,
-                                 callback=_Clock(owner.max_wall_time))
+                                 callback=_Clock(owner.max_wall_time if max_wall_time is None else max_wall_time))
         except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # failed evaluation or factorization
             return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
                                 time.perf_counter() - start, f"{type(exc).__name__}: {exc}")

@@ -285,14 +285,14 @@ class _Run:
     """One solve: the iteration state (iterate, penalty ρ, radius Δ, counters) and its steps."""
 
     def __init__(self, prepared: PreparedScp, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
-                 curvature: _Curvature) -> None:
+                 curvature: _Curvature, max_wall_time: float) -> None:
         nlp, settings = prepared.nlp, prepared.settings
         self.subproblem, self.settings, self.curvature = prepared.subproblem, settings, curvature
         self.lbx, self.ubx = (np.asarray(b, dtype=float) for b in bounds)
         self.free = self.lbx < self.ubx
         self.evaluate = _Evaluator(prepared.functions, params, np.asarray(nlp.lbg, float), np.asarray(nlp.ubg, float))
         self.rho, self.radius = settings.penalty, settings.trust_radius
-        self.deadline = time.perf_counter() + settings.max_wall_time
+        self.deadline = time.perf_counter() + max_wall_time
         self.qps, self.accepted, self.corrections = 0, 0, 0
         self.lam_g: np.ndarray | None = None
 
@@ -413,12 +413,14 @@ class PreparedScp(PreparedSolver):
     subproblem: _Subproblem
     settings: _Settings
 
-    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:
+    def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
+              max_wall_time: float | None = None) -> SolverResult:
         params = np.asarray(params, dtype=float)
         curvature = _ExactCurvature(self.functions, params) if self.functions.hess_f is not None \
             else _DampedBfgs(self.nlp.x.numel())
         start = time.perf_counter()
-        run = _Run(self, params, bounds, curvature)
+        run = _Run(self, params, bounds, curvature,
+                   self.settings.max_wall_time if max_wall_time is None else max_wall_time)
         try:
             point, status, message = run.run(np.asarray(guess, dtype=float))
         except cp.error.SolverError as exc:

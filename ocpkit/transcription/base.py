@@ -11,12 +11,15 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
+from itertools import count
+from typing import ClassVar
 
 import numpy as np
 
 from ocpkit.constraints import Constraint
 from ocpkit.constraints.collision import MAX_MARGIN
 from ocpkit.dynamics import Dynamics
+from ocpkit.errors import OptionError
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.nlp import NLP, Refinement
 from ocpkit.problem import Problem
@@ -90,9 +93,35 @@ class Discretization(ABC):
 
 
 class Transcription(ABC):
-    """A transcription method with its options (knots, ...); `build` makes its Discretization for a problem."""
+    """A transcription method with its options (knots, ...); `build` makes its Discretization for a problem.
+
+    Its constructor checks the knot count (`check_knots`) before anything is built."""
 
     name: str
+    max_intervals: ClassVar[int]
+    """The most knot intervals (over all segments) it builds within about a minute and 1.5 GB on 2 cores
+    (docs/design-notes.md)."""
+
+    @abstractmethod
+    def free_path_values(self, knots: int) -> int:
+        """How many values of each joint's path the NLP at `knots` leaves free besides t_f: q, q̇, q̈ at every
+        point, less the collocation rows and the 6 fixed by rest at start and goal (u follows from the dynamics)."""
+
+    def check_knots(self, knots: int, intervals: int) -> None:
+        """OptionError unless the NLP at `knots` (`intervals` in all) leaves the path a free value and has at most
+        max_intervals: with fewer knots the start and goal conditions fix or over-determine the path."""
+        if self.free_path_values(knots) < 1:
+            smallest = next(n for n in count(2) if self.free_path_values(n) >= 1)
+            raise OptionError(f"{self.name} needs knots ≥ {smallest}{self._segments_text()}, got {knots}: with fewer "
+                              "the start and goal conditions leave the path no free values")
+        if intervals > self.max_intervals:
+            raise OptionError(f"{self.name} takes at most {self.max_intervals} knot intervals (knots × segments), "
+                              f"got {intervals}: a larger NLP takes too long and too much memory to build")
+
+    def _segments_text(self) -> str:
+        """" on K segments" where that changes the bound, else ""."""
+        segments = getattr(self, "segments", 1)
+        return f" on {segments} segments" if segments > 1 else ""
 
     @abstractmethod
     def options_key(self) -> tuple:

@@ -21,7 +21,6 @@ import numpy as np
 
 from ocpkit.constraints import Constraint
 from ocpkit.dynamics import Dynamics
-from ocpkit.errors import OptionError
 from ocpkit.nlp import Refinement, Stages
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot
@@ -189,10 +188,16 @@ class MeshTranscription(Transcription):
 
     discretization: type[MeshDiscretization]
 
+    max_intervals = 256
+
     def __init__(self, knots: int = 20, margin: float = 0.01, staged: bool = False) -> None:
-        if knots < 2:
-            raise OptionError(f"{self.name} needs knots ≥ 2, got {knots}")
         self.knots, self.margin, self.staged = knots, margin, staged
+        self.check_knots(knots, knots)
+
+    def free_path_values(self, knots: int) -> int:
+        """3 values per knot and midpoint, less 2 rows per interval (4 with midpoints), less 6."""
+        midpoints = int(self.discretization.midpoints)
+        return 3 * (knots + 1 + knots * midpoints) - 2 * knots * (1 + midpoints) - 6
 
     def options_key(self) -> tuple:
         return self.name, self.knots, self.margin, self.staged

@@ -201,12 +201,18 @@ class Pseudospectral(Transcription):
 
     family: NodeFamily
 
+    max_intervals = 64
+
     def __init__(self, knots: int = 12, segments: int = 1, margin: float = 0.01, adaptive_checks: int = 4) -> None:
-        if knots < 2:
-            raise OptionError(f"{self.name} needs knots ≥ 2, got {knots}")
         if segments < 1:
             raise OptionError(f"{self.name} needs segments ≥ 1, got {segments}")
         self.knots, self.segments, self.margin, self.adaptive_checks = knots, segments, margin, adaptive_checks
+        self.check_knots(knots, knots * segments)
+
+    def free_path_values(self, knots: int) -> int:
+        """3 (K N + 1) point values less 2 rows per collocated point, less 6."""
+        collocated = self.segments * int(self.family.collocation_mask(knots).sum())
+        return 3 * (self.segments * knots + 1) - 2 * collocated - 6
 
     def options_key(self) -> tuple:
         return self.name, self.knots, self.segments, self.margin, self.adaptive_checks

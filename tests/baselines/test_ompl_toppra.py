@@ -134,3 +134,16 @@ def test_ompl_guess_is_the_baseline_motion_on_the_nlp_grid(case1):
     np.testing.assert_allclose(decoded.interpolant(np.array([middle])).q,
                                baseline.trajectory.interpolant(np.array([middle])).q, atol=0.05)
     np.testing.assert_array_equal(ompl_guess(case1, nlp, planning_time=0.0), nlp.initial_guess(case1))
+
+
+def test_a_goal_equal_to_the_start_is_a_verified_hold_at_the_start(case1):
+    still = plan_ompl_toppra(dataclasses.replace(case1, goal=case1.start.copy()))
+    assert still.status == "verified", still.verification.summary()
+    assert still.trajectory.tf == case1.time.min and still.found
+    np.testing.assert_array_equal(still.trajectory.sample().q, np.tile(case1.start, (101, 1)))
+
+
+def test_no_path_says_that_no_trajectory_was_found(case1):
+    plan = plan_ompl_toppra(case1, planning_time=0.0)
+    assert not plan.found and plan.stats.iterations == 0
+    assert "no trajectory" in plan.stats.solver_message and "raise planning_time" in plan.hint

@@ -8,7 +8,7 @@ import pytest
 
 from ocpkit.bench.convergence import COLUMNS, groups, read_rows, run_convergence
 
-TINY = {"chebyshev": (6, 10, 14), "lgr": (6, 10, 14), "trapezoidal": (8, 16)}
+TINY = {"chebyshev": (6, 10, 14), "lgr": (6, 10, 14), "trapezoidal": (16, 32)}
 
 
 @pytest.mark.slow

@@ -145,8 +145,8 @@ def test_a_constraint_class_can_be_passed_to_make_constraints():
 
 
 def test_a_third_party_constraint_adds_rows_to_the_built_nlp():
-    plain = ocpkit.build(PROBLEM, knots=4)
-    extra = ocpkit.build(PROBLEM, knots=4, constraints=DEFAULT_CONSTRAINTS + (JointOneSlow,))
+    plain = ocpkit.build(PROBLEM, knots=6)
+    extra = ocpkit.build(PROBLEM, knots=6, constraints=DEFAULT_CONSTRAINTS + (JointOneSlow,))
     assert extra.discretization is not plain.discretization
     assert [c.name for c in extra.discretization.constraints] == [*DEFAULT_CONSTRAINTS, "joint-1-slow"]
     added = extra.discretization.nlp.g.numel() - plain.discretization.nlp.g.numel()

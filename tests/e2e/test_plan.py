@@ -9,6 +9,7 @@ import json
 import shutil
 import subprocess
 import sys
+import time
 
 import pytest
 from helpers import REPO
@@ -135,3 +136,19 @@ def test_paper_benchmark_takes_another_transcription(tmp_path, capsys):
                                transcription="hermite-simpson", knots=(10,))
     assert (rows[0]["transcription"], rows[0]["knots"], rows[0]["status"]) == ("hermite-simpson", 10, "verified")
     assert "hermite-simpson + ipopt" in capsys.readouterr().out
+
+
+def test_a_diverging_solver_stops_early_and_writes_a_small_file(tmp_path):
+    """sqpmethod on random problem 3 of seed 1 (12 knots): a failed QP sends the iterate out of its bounds
+    (before issue 10: time_limit after 66–87 s, t_f 184–3837 s, gigabytes of samples)."""
+    from ocpkit.bench.random import random_problems
+
+    problem = list(random_problems(1, 3))[2]
+    began = time.perf_counter()
+    result = ocpkit.plan(problem, knots=12, solver="sqpmethod", max_wall_time=60.0)
+    assert time.perf_counter() - began < 61.0 + result.stats.setup_time
+    assert result.status in ("failed", "time_limit") and not result.ok
+    path = tmp_path / "diverged.json"
+    ocpkit.write_json(path, result.trajectory, trajectory_header(problem, result),
+                      time_bounds=(problem.time.min, problem.time.max))
+    assert path.stat().st_size < 12_000_000  # at most 10 s of 1 ms samples

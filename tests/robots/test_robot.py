@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 
 import numpy as np
@@ -119,7 +120,11 @@ def test_missing_file_is_named(tmp_path):
     ({"joints": ["joint_2", "joint_1"]}, "must follow the URDF tree order"),
     ({"gear_ratios": [1, 2]}, "'gear_ratios' needs 6 values"),
     ({"spheres": [{"link": "nowhere", "center": [0, 0, 0], "radius": 0.1}]}, "unknown link 'nowhere'"),
+    ({"joints": ["joint_1", "joint_1"]}, "each joint once"),
     ({"self_collision": [[0, 99]]}, "self_collision index outside"),
+    ({"self_collision": [[3, 3]]}, r"paired with itself: self_collision\[0\] = \[3, 3\]"),
+    ({"spheres": [{"link": "link_1", "center": [0, 0, 0], "radius": 0.1, "radious": 1}]},
+     r"unknown keys \['spheres\[0\].radious'\]; allowed: \['center', 'link', 'radius'\]"),
     ({"friction": {"viscous": [0] * 6, "coulomb": [0] * 6, "smoothing": 0}}, "smoothing must be > 0"),
 ])
 def test_broken_spec_is_explained(tmp_path, changes, message):
@@ -128,6 +133,22 @@ def test_broken_spec_is_explained(tmp_path, changes, message):
         load_robot({"urdf": str(SPEC.parent / "robot.urdf"), "spec": str(tmp_path / "spec.yaml")})
 
 
-def test_robot_must_be_name_or_files():
-    with pytest.raises(RobotError, match="built-in name or"):
-        load_robot({"urdf": "x"})
+@pytest.mark.parametrize("robot, message", [
+    ({"urdf": "x"}, "missing 'robot.spec'"),
+    ({"urdf": 3, "spec": ["a"]}, "robot.urdf must be a string, got 3"),
+    (3, "robot must be a built-in robot name or a mapping with keys spec, urdf, got 3"),
+    ("../data/industrial6", "unknown robot '../data/industrial6'"),  # a name, never a path
+])
+def test_robot_must_be_name_or_files(robot, message):
+    with pytest.raises(RobotError, match=re.escape(message)):
+        load_robot(robot)
+
+
+def test_a_broken_urdf_is_one_line_with_the_parsers_reason(tmp_path, capfd):
+    (tmp_path / "robot.urdf").write_text('<robot name="x"><link name="a"/><joint name="j" type="revolute">'
+                                         '<parent link="a"/><child link="b"/></joint></robot>')
+    with pytest.raises(RobotError) as error:
+        load_robot({"urdf": "robot.urdf", "spec": str(SPEC)}, tmp_path)
+    assert str(error.value).startswith(f"{tmp_path / 'robot.urdf'}: not a valid URDF: ")
+    assert "does not specify limits" in str(error.value) and "\n" not in str(error.value)
+    assert capfd.readouterr().err == ""  # the parser's console lines are in the message, not on the terminal

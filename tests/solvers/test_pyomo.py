@@ -69,7 +69,7 @@ def test_an_mx_nlp_is_refused():
 @pytest.mark.parametrize("dynamics", ["pinocchio", "pinocchio-rnea"])
 def test_an_nlp_around_a_callback_is_refused(dynamics):
     problem = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
-    nlp = discretize(problem, "chebyshev", dynamics, knots=2).nlp
+    nlp = discretize(problem, "chebyshev", dynamics, knots=6).nlp
     assert isinstance(nlp.x, ca.MX) and not nlp.exact_hessian
     with pytest.raises(OptionError, match="evaluates through a callback"):
         PyomoRipopt().prepare(nlp)

@@ -79,3 +79,16 @@ def test_solver_plans_a_paper_case(name):
     assert plan.status in {"verified", "violated", "iteration_limit", "time_limit", "failed", "infeasible"}
     if name in VERIFIES:
         assert plan.status == "verified", plan.stats.solver_message
+
+
+@pytest.mark.parametrize("name", sorted(set(ALL_SOLVERS) - {"blocksqp", "fatrop"}))  # these cannot be interrupted
+def test_a_per_call_time_limit_overrides_the_solvers_own(name):
+    prepared = ALL_SOLVERS[name](max_wall_time=60.0).prepare(rosenbrock_disk())
+    assert prepared.solve(GUESS, PARAMS, BOUNDS, max_wall_time=1e-9).status == SolverStatus.TIME_LIMIT
+    assert prepared.solve(GUESS, PARAMS, BOUNDS).status == SolverStatus.CONVERGED  # the next call: its own again
+
+
+@pytest.mark.parametrize("name", ["blocksqp", "fatrop"])
+def test_an_uninterruptible_solver_reports_an_overrun_of_the_per_call_limit(name):
+    prepared = ALL_SOLVERS[name](max_wall_time=60.0, max_iterations=2).prepare(rosenbrock_disk())
+    assert prepared.solve(GUESS, PARAMS, BOUNDS, max_wall_time=1e-9).status == SolverStatus.TIME_LIMIT

@@ -19,7 +19,7 @@ PROBLEM = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
 TF = 2.0
 # name → (intervals N, the highest degree of q(t) the method is exact for)
 METHODS = {"trapezoidal": (5, 2), "hermite-simpson": (4, 3)}
-PAPER_KNOTS = {"trapezoidal": 20, "hermite-simpson": 10}
+PAPER_KNOTS = {"trapezoidal": 40, "hermite-simpson": 10}
 
 
 @functools.cache

@@ -1,0 +1,51 @@
+"""The random suite's problems: seeded, the original one-sphere suite unchanged, 1–3 spheres in the way."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+from ocpkit.bench import random as suite
+from ocpkit.bench.random import PATH_SPHERES, RADII, random_problems
+from ocpkit.geometry import clearances, sphere_centers
+
+
+def test_the_original_suite_keeps_its_problems():
+    first = next(random_problems(1, 30))
+    np.testing.assert_allclose(np.degrees(first.start[:2]), [3.5465, 73.0649], atol=1e-4)  # seed 1 of issue 9
+    assert first.scene.obstacle_radii.shape == (1,) and first.name == "random30"
+
+
+def test_more_obstacles_are_seeded_and_within_the_range():
+    problems = list(random_problems(100, 30, (1, 3)))
+    again = list(random_problems(100, 30, (1, 3)))
+    counts = [len(p.scene.obstacle_radii) for p in problems]
+    assert set(counts) == {1, 2, 3}
+    assert all(np.array_equal(p.scene.obstacle_centers, q.scene.obstacle_centers) for p, q in zip(problems, again))
+    radii = np.concatenate([p.scene.obstacle_radii for p in problems])
+    assert RADII[0] <= radii.min() and radii.max() <= RADII[1]
+
+
+def test_the_obstacles_are_in_the_way_of_the_straight_path():
+    """Each problem's straight joint-space path passes within 0.3 m of every obstacle with some robot sphere."""
+    for problem in random_problems(100, 10, (2, 3)):
+        path = np.linspace(problem.start, problem.goal, 41)
+        centres = sphere_centers(problem.robot, path)[:, PATH_SPHERES]  # (41, k, 3)
+        for obstacle in problem.scene.obstacle_centers:
+            assert np.linalg.norm(centres - obstacle, axis=-1).min() < 0.3 + RADII[1]
+        ends = clearances(problem.robot, problem.scene, sphere_centers(problem.robot, np.stack([problem.start,
+                                                                                               problem.goal])))
+        assert ends.smallest() >= 0.0
+
+
+@pytest.mark.slow
+def test_run_random_writes_results_trajectories_and_scenarios(tmp_path, capsys):
+    statuses = suite.run_random(1, 2, knots=8, obstacles=(1, 2), out=tmp_path)
+    rows = list(csv.DictReader((tmp_path / "results.csv").open()))
+    assert sum(statuses.values()) == 2 and len(rows) == 2
+    assert len(list((tmp_path / "trajectories").glob("*.json"))) == 2
+    assert len(list((tmp_path / "scenarios").glob("*.yaml"))) == 2
+    printed = capsys.readouterr().out
+    assert "90th percentile" in printed or "no verified plan" in printed
