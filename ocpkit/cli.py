@@ -51,6 +51,8 @@ def _planner_options(args: argparse.Namespace) -> dict:
     given = {option: getattr(args, key) for key, option in names.items() if getattr(args, key) is not None}
     if args.segments is not None:
         given["transcription_options"] = {"segments": args.segments}
+    if args.single_shot:
+        given["fallbacks"] = ()
     if "seed" in given and "guess_options" in _option_names(args.planner):  # the seed of the OMPL guess
         given["guess_options"] = {"seed": given.pop("seed")}
     return given
@@ -106,9 +108,10 @@ def _bench_command(args: argparse.Namespace) -> int:
         run_convergence(out, case=Path(args.case or DEFAULT_CASE))
     elif args.suite == "random":
         from ocpkit.bench.random import run_random
+        from ocpkit.ladder import DEFAULT_LADDER, SINGLE_SHOT
 
         run_random(args.seed, args.count, _one_knot_count(args, "chebyshev"), obstacles=tuple(args.obstacles),
-                   out=out)
+                   out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER)
     elif args.suite == "solvers":
         from ocpkit.bench.solvers import run_solver_benchmark
 
@@ -209,6 +212,9 @@ def parser() -> argparse.ArgumentParser:
                    "planner's --guess ompl")
     p.add_argument("--max-wall-time", type=float, help="time limit of the whole plan, s (ompl-toppra: OMPL's "
                    "planning time, default 1)")
+    p.add_argument("--single-shot", action="store_true", help="simultaneous: one solve with the given options, "
+                   "no fallback ladder (the paper's setting; default: the ladder of ocpkit.ladder, first verified "
+                   "rung wins)")
     p.add_argument("--mu", type=float, default=None, help="jerk weight μ ≥ 0 (default: the scenario's)")
     p.add_argument("-o", "--output", help="write the trajectory JSON here (checked before planning; not written "
                    "when interrupted)")
@@ -243,6 +249,8 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--count", type=int, default=30, help="random: number of problems (default 30)")
     b.add_argument("--obstacles", type=int, nargs=2, default=[1, 1], metavar=("MIN", "MAX"),
                    help="random: obstacles per problem, drawn from MIN..MAX (default 1 1)")
+    b.add_argument("--single-shot", action="store_true", help="random: plan without the fallback ladder (the "
+                   "paper's one solve; bench paper always plans so)")
     b.set_defaults(run=_bench_command)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")

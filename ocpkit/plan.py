@@ -74,9 +74,12 @@ class Plan:
 
     @property
     def hint(self) -> str:
-        """What to try, one sentence from the status and the verification or solver message; "" when verified."""
+        """What to try, one sentence: the planner's own (stats.extra["hint"]) if it gave one, else from the status
+        and the verification or solver message; "" when verified."""
         if self.ok:
             return ""
+        if "hint" in self.stats.extra:  # a planner's own word (the fallback ladder's)
+            return self.stats.extra["hint"]
         if self.status == "failed":
             return f"the solver failed ({self.stats.solver_message}); try another guess (guess=ompl) or solver"
         if self.status in STOPPED_HINTS:

@@ -16,6 +16,7 @@ from ocpkit.build_cache import build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import OptionError
+from ocpkit.ladder import DEFAULT_LADDER, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
@@ -35,7 +36,7 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
                       constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
                       transcription_options: dict | None = None, solver_options: dict | None = None,
                       dynamics_options: dict | None = None, max_wall_time: float = 60.0,
-                      guess_options: dict | None = None) -> Plan:
+                      guess_options: dict | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER) -> Plan:
     """Plan `problem` with path and timing together.
 
     `knots` is N, the intervals per segment of a pseudospectral transcription (K N + 1 points on K `segments`) or
@@ -44,22 +45,67 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     `guess_options` for the rule (e.g. {"seed": 3, "planning_time": 2.0} for "ompl", the baseline's options);
     `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess is part of
     the computation time; the one-time set-up is not. `max_wall_time` (s) bounds the computation
-    (guess, every solve and refinement round): each solve gets the time left (a solver that cannot be
-    interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when it
-    runs out."""
+    (guess, every solve and refinement round, every rung): each solve gets the time left (a solver that cannot
+    be interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when it
+    runs out. `fallbacks` is the ladder of rungs (ocpkit.ladder), each overriding these options, tried in order
+    until one plan verifies; () plans once with these options (SINGLE_SHOT, the paper's setting)."""
+    options = {"transcription": transcription, "knots": knots, "dynamics": dynamics, "solver": solver,
+               "guess": guess, "refinements": refinements, "constraints": constraints,
+               "transcription_options": transcription_options or {}, "solver_options": solver_options or {},
+               "dynamics_options": dynamics_options, "guess_options": guess_options or {}}
+    return climb(lambda rung, left: _single_shot(problem, _overridden(options, rung), left,
+                                                 skip_without_path=rung is not None and rung.guess is not None),
+                 fallbacks, max_wall_time)
+
+
+def _overridden(options: dict, rung: Rung | None) -> dict:
+    """The options of `plan_simultaneous` with `rung`'s overrides applied (`options` itself for None); a rung's
+    guess comes with its own options (its seed) instead of the call's; the call's own max_iterations wins over a
+    rung's cap."""
+    if rung is None:
+        return options
+    changed = dict(options)
+    if rung.guess is not None:
+        changed["guess"] = rung.guess
+        changed["guess_options"] = {} if rung.seed is None else {"seed": rung.seed}
+    if rung.knots is not None:
+        changed["knots"] = rung.knots
+    if rung.segments is not None:
+        changed["transcription_options"] = {**options["transcription_options"], "segments": rung.segments}
+    if rung.max_iterations is not None:
+        changed["solver_options"] = {"max_iterations": rung.max_iterations, **options["solver_options"]}
+    return changed
+
+
+def _single_shot(problem: Problem, options: dict, max_wall_time: float, skip_without_path: bool = False) -> Plan:
+    """One plan with `options` (those of `plan_simultaneous`): build, guess, solve with refinement rounds, all
+    within `max_wall_time` (s) of computation. With `skip_without_path`, a guess rule other than "line" that
+    found no path (it gave the straight line instead) ends the plan as `no_path` before any solve."""
     started = time.perf_counter()
-    made = build(problem, transcription, knots, dynamics, solver, constraints, transcription_options,
-                 solver_options, dynamics_options)
+    made = build(problem, options["transcription"], options["knots"], options["dynamics"], options["solver"],
+                 options["constraints"], options["transcription_options"], options["solver_options"],
+                 options["dynamics_options"])
     deadline = time.perf_counter() + max_wall_time
-    w = _guess(problem, made.discretization, guess, guess_options or {})
-    refined = solve_refined(made.discretization, made.solver, problem, w, refinements, deadline)
+    w = _guess(problem, made.discretization, options["guess"], options["guess_options"])
+    dynamics = options["dynamics"]
+    method = {"planner": "simultaneous", "transcription": options["transcription"], "knots": options["knots"],
+              "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options["solver"]}
+    if skip_without_path and _fell_back_to_line(problem, made.discretization, options["guess"], w):
+        return finish(problem, made.discretization.decode(w), "no_path", method, started, setup_time=made.setup_time,
+                      message=f"guess {options['guess']!r} found no path (it gave the straight line): not solved")
+    refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline)
     result = refined.result
-    method = {"planner": "simultaneous", "transcription": transcription, "knots": knots,
-              "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": solver}
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=made.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
                   verification=refined.verification)
+
+
+def _fell_back_to_line(problem: Problem, discretization: Discretization, guess: str | np.ndarray,
+                       w: np.ndarray) -> bool:
+    """Whether the named guess rule `guess`, other than "line", gave the straight-line guess w (n_w,) (the "ompl"
+    rule does when OMPL finds no path)."""
+    return isinstance(guess, str) and guess != "line" and np.array_equal(w, line_guess(problem, discretization))
 
 
 def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray, options: dict) -> np.ndarray:

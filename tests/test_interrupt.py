@@ -58,9 +58,10 @@ def test_a_new_watch_forgets_an_old_interrupt():
 
 def test_ctrl_c_during_plan_exits_130_with_one_line_and_no_file(tmp_path):
     out = tmp_path / "out.json"
-    process = subprocess.Popen([*OCPKIT, "plan", str(REPO / "scenarios/paper/case1.yaml"), "--knots", "24", "-o",
-                                str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-    interrupt_when_busy(process, cpu=6.0)
+    process = subprocess.Popen([*OCPKIT, "plan", str(REPO / "scenarios/paper/case1.yaml"), "--solver", "sqpmethod",
+                                "--single-shot", "-o", str(out)],  # a solve of about 10 s: the signal lands in it
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    interrupt_when_busy(process, cpu=5.0)
     time.sleep(0.2)
     process.send_signal(signal.SIGINT)  # a second Ctrl-C while it finishes: still no traceback
     stdout, stderr = process.communicate(timeout=120)

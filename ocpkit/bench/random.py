@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import csv
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +23,7 @@ import yaml
 from ocpkit.bench.common import machine
 from ocpkit.errors import ScenarioError
 from ocpkit.geometry import sphere_centers
+from ocpkit.ladder import DEFAULT_LADDER, Rung
 from ocpkit.plan import Plan
 from ocpkit.planner import plan
 from ocpkit.problem import Problem, TimeBounds
@@ -84,16 +85,18 @@ def _near(rng: np.random.Generator, robot: Robot, start: np.ndarray, goal: np.nd
 
 
 def run_random(seed: int = 1, count: int = 30, knots: int = 12, obstacles: tuple[int, int] = (1, 1),
-               out: Path | None = None) -> Counter:
+               out: Path | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER) -> Counter:
     """Plan `count` random problems of `seed` (with `obstacles` spheres) with the simultaneous planner's defaults
-    at `knots`; print a line per problem and the summary; with `out`, write results.csv, the trajectories and
-    the scenarios there. Returns the status counts."""
-    statuses, verified_times, rows = Counter(), [], []
+    at `knots` and the ladder `fallbacks` (SINGLE_SHOT: the paper's one solve); print a line per problem, the
+    summary and which rung verified how many; with `out`, write results.csv, the trajectories and the scenarios
+    there. Returns the status counts."""
+    statuses, rungs, verified_times, rows = Counter(), Counter(), [], []
     for problem in random_problems(seed, count, obstacles):
-        result = plan(problem, knots=knots)
+        result = plan(problem, knots=knots, fallbacks=fallbacks)
         statuses[result.status] += 1
         if result.ok:
             verified_times.append(result.stats.solve_time)
+            rungs[result.method.get("rung", "single shot")] += 1
         print(_line(problem, result), flush=True)
         if out is not None:
             rows.append(result_row("random", problem.name, result, result.stats.solve_time, result.stats.setup_time))
@@ -101,13 +104,16 @@ def run_random(seed: int = 1, count: int = 30, knots: int = 12, obstacles: tuple
     if out is not None:
         _write_csv(Path(out) / "results.csv", rows)
     print(f"{dict(statuses)}; {_times(verified_times)} at {knots} knots; {machine()}")
+    print(f"verified by rung: {dict(rungs)}")
     return statuses
 
 
 def _line(problem: Problem, result: Plan) -> str:
-    """The printed line of one problem: status, t_f, time, rounds, and the hint when it did not verify."""
+    """The printed line of one problem: status, t_f, time, rounds, the ladder's rung, and the hint when it did
+    not verify."""
     return (f"{problem.name:<10}{result.status:>16}  t_f {result.trajectory.tf:5.2f} s (bound "
             f"{problem.velocity_lower_bound():4.2f})  {result.stats.solve_time:5.2f} s  {result.stats.rounds} rounds"
+            f"  rung {result.method.get('rung', '-')}"
             + ("" if result.ok else f"  {result.verification.summary()}; hint: {result.hint}"))
 
 

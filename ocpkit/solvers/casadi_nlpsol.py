@@ -102,17 +102,21 @@ class _Deadline(ca.Callback):
         return ca.Sparsity.dense(self.sizes[ca.nlpsol_out(i)], 1)
 
     def eval(self, arg: list) -> list:
-        x = np.asarray(arg[0]).ravel()
-        if not np.all((x >= self.lower) & (x <= self.upper)):
-            self.reason = "bounds"
-        elif time.perf_counter() > self.deadline:
-            self.reason = "deadline"
+        try:
+            x = np.asarray(arg[0]).ravel()
+            if not np.all((x >= self.lower) & (x <= self.upper)):
+                self.reason = "bounds"
+            elif time.perf_counter() > self.deadline:
+                self.reason = "deadline"
+        except KeyboardInterrupt:  # Ctrl-C landed in this callback: stop the solve (ocpkit.interrupt re-raises it)
+            self.reason = "interrupted"
         return [1 if self.reason else 0]
 
 
-_STOPPED = {"deadline": SolverStatus.TIME_LIMIT, "bounds": SolverStatus.FAILED}
+_STOPPED = {"deadline": SolverStatus.TIME_LIMIT, "bounds": SolverStatus.FAILED, "interrupted": SolverStatus.FAILED}
 """Our status when the `_Deadline` callback stopped the solve, by its reason."""
-_STOP_MESSAGES = {"deadline": "stopped at the wall-time limit", "bounds": "stopped: iterate outside its bounds"}
+_STOP_MESSAGES = {"deadline": "stopped at the wall-time limit", "bounds": "stopped: iterate outside its bounds",
+                  "interrupted": "stopped by Ctrl-C"}
 
 
 @dataclass(frozen=True)

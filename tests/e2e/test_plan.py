@@ -17,6 +17,7 @@ from helpers import REPO
 import ocpkit
 from ocpkit.bench.paper import run_paper_benchmark
 from ocpkit.cli import main
+from ocpkit.ladder import SINGLE_SHOT
 from ocpkit.report import RESULT_COLUMNS, trajectory_header
 
 CASES = sorted((REPO / "scenarios/paper").glob("case*.yaml"))
@@ -45,7 +46,7 @@ def test_second_query_of_a_shape_reuses_the_build():
 
 def test_iteration_limit_is_a_status_not_a_success():
     problem = ocpkit.load_scenario(CASES[0])
-    result = ocpkit.plan(problem, knots=8, solver_options={"max_iterations": 3})
+    result = ocpkit.plan(problem, knots=8, solver_options={"max_iterations": 3}, fallbacks=SINGLE_SHOT)
     assert result.status == "iteration_limit" and not result.ok
 
 
@@ -104,9 +105,9 @@ def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
 def test_refinement_repairs_contact_between_check_times():
     problem = ocpkit.load_scenario(CASES[1])
     no_margin = {"margin": 0.0}
-    unrefined = ocpkit.plan(problem, knots=8, refinements=0, transcription_options=no_margin)
+    unrefined = ocpkit.plan(problem, knots=8, refinements=0, transcription_options=no_margin, fallbacks=SINGLE_SHOT)
     assert unrefined.status == "violated" and unrefined.verification.penetration > 0
-    refined = ocpkit.plan(problem, knots=8, transcription_options=no_margin)
+    refined = ocpkit.plan(problem, knots=8, transcription_options=no_margin, fallbacks=SINGLE_SHOT)
     assert refined.ok and refined.stats.rounds >= 1
     assert refined.stats.setup_time == 0.0  # the same NLP, re-solved: refinement needs no rebuild
 
@@ -145,7 +146,7 @@ def test_a_diverging_solver_stops_early_and_writes_a_small_file(tmp_path):
 
     problem = list(random_problems(1, 3))[2]
     began = time.perf_counter()
-    result = ocpkit.plan(problem, knots=12, solver="sqpmethod", max_wall_time=60.0)
+    result = ocpkit.plan(problem, knots=12, solver="sqpmethod", max_wall_time=60.0, fallbacks=SINGLE_SHOT)
     assert time.perf_counter() - began < 61.0 + result.stats.setup_time
     assert result.status in ("failed", "time_limit") and not result.ok
     path = tmp_path / "diverged.json"

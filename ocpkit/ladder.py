@@ -1,0 +1,119 @@
+"""The fallback ladder of the simultaneous planner: the rungs tried in order until one plan verifies.
+
+A `Rung` is a small set of option overrides (initial guess and OMPL seed, knots, segments, an iteration cap per
+solve) applied to the options of the call. `climb` plans rung after rung within one wall-time budget and
+returns the first verified plan, else the best one (`rank`), with every rung's name, status, time and
+iterations in `stats.extra["rungs"]`. A rung that only lifts the iteration cap of an earlier one is skipped
+(listed in `stats.extra["skipped"]`) unless that one stopped at its cap: it would repeat the same solve. An
+empty ladder plans once with the call's options (the paper's single shot).
+
+Why these rungs (tuned on `ocpkit bench random --seed 200 --count 40 --obstacles 1 3`: 33 of 40 verified, the
+other 7 with no OMPL path; measured on seed 300 in README.md): the straight line verifies most
+problems within a few hundred IPOPT iterations, and one that has not converged by then usually ends infeasible
+or at the iteration limit after many seconds, so the first rung is capped (MAX_ITERATIONS_CAPPED); the OMPL +
+TOPP-RA motion (collision-free by construction) is the better start in clutter, and another seed gives another
+homotopy class when the first one is poor; more knots resolve what a coarse grid leaves violated; the last rung
+is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single shot finds
+in time.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from ocpkit.plan import Plan, PlanStats
+
+MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
+
+
+@dataclass(frozen=True)
+class Rung:
+    """Option overrides of one attempt: `guess` ("line", "ompl" or None for the call's), OMPL `seed`, `knots`
+    and pseudospectral `segments` (None: the call's), and `max_iterations` per solve (None: the solver's)."""
+
+    name: str
+    guess: str | None = None
+    seed: int | None = None
+    knots: int | None = None
+    segments: int | None = None
+    max_iterations: int | None = None
+
+
+DEFAULT_LADDER: tuple[Rung, ...] = (
+    Rung("first", max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-0", guess="ompl", seed=0, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-1", guess="ompl", seed=1, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("first-uncapped"),
+)
+"""The default ladder (module docstring says why each rung is there)."""
+
+SINGLE_SHOT: tuple[Rung, ...] = ()
+"""No fallbacks: one plan with the call's options (the paper's setting)."""
+
+NO_PATH_HINT = ("no rung verified, and OMPL found no collision-free path within its budget either: the obstacles "
+                "may block every way from start to goal (the ompl-toppra planner with a larger planning_time tells)")
+"""The hint of a ladder that failed where an OMPL rung found no path."""
+
+STATUS_ORDER = ("verified", "violated", "infeasible", "iteration_limit", "time_limit", "failed", "no_path")
+"""Plan statuses from best to worst, for `rank`."""
+
+
+def rank(plan: Plan) -> tuple[int, float]:
+    """Sort key of a plan, smaller is better: its status by STATUS_ORDER, then its largest failed check's worst
+    value (the check's unit: relative for limits, m for contact)."""
+    worst = max((c.worst for c in plan.verification.checks if not c.ok), default=0.0)
+    return STATUS_ORDER.index(plan.status) if plan.status in STATUS_ORDER else len(STATUS_ORDER), worst
+
+
+def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:
+    """Plan with `attempt(rung, seconds left)` on each rung of `ladder` in turn (on None once if it is empty)
+    until one verifies or the `max_wall_time` (s) of computation is spent; the first verified plan, else the
+    best by `rank`, with the stats of all attempts (module docstring)."""
+    if not ladder:
+        return attempt(None, max_wall_time)
+    tried: list[tuple[Rung, Plan]] = []
+    skipped: list[str] = []
+    for rung in ladder:
+        left = max_wall_time - sum(p.stats.solve_time for _, p in tried)
+        if tried and left <= 0:
+            break
+        if _repeats(rung, tried):
+            skipped.append(rung.name)
+            continue
+        tried.append((rung, attempt(rung, max(left, 0.0))))
+        if tried[-1][1].ok:
+            break
+    return _combined(tried, skipped)
+
+
+def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:
+    """Whether `rung` is an earlier rung with only another iteration cap, and that one stopped short of its cap
+    (any status but iteration_limit): the solve would repeat itself."""
+    def solve(r: Rung) -> Rung:
+        return dataclasses.replace(r, name="", max_iterations=None)
+
+    return any(solve(r) == solve(rung) and p.status != "iteration_limit" for r, p in tried)
+
+
+def _combined(tried: list[tuple[Rung, Plan]], skipped: list[str]) -> Plan:
+    """The best plan of `tried` (rung, plan) pairs, its stats summed over all of them (with the names of the
+    `skipped` rungs) and its method and message naming its rung; its hint NO_PATH_HINT (through
+    stats.extra["hint"]) if it failed and OMPL found no path."""
+    rung, best = min(tried, key=lambda pair: rank(pair[1]))
+    plans = [p for _, p in tried]
+    stats = PlanStats(sum(p.stats.solve_time for p in plans), sum(p.stats.setup_time for p in plans),
+                      sum(p.stats.iterations for p in plans), best.stats.rounds,
+                      f"rung {rung.name}: {best.stats.solver_message}",
+                      {**best.stats.extra, "rungs": [_rung_row(r, p) for r, p in tried], "skipped": skipped})
+    if not best.ok and any(p.status == "no_path" for p in plans):
+        stats.extra["hint"] = NO_PATH_HINT
+    return dataclasses.replace(best, stats=stats, method={**best.method, "rung": rung.name})
+
+
+def _rung_row(rung: Rung, plan: Plan) -> dict:
+    """One rung's entry in stats.extra["rungs"]: name, status, computation time (s), iterations."""
+    return {"rung": rung.name, "status": plan.status, "time_s": round(plan.stats.solve_time, 3),
+            "iterations": plan.stats.iterations}

@@ -1,0 +1,182 @@
+"""Issue 11: the fallback ladder — rung order, first verified wins, best-of on failure, the shared time budget,
+rung overrides, OMPL rungs without a path, and the single shot of the paper."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers import REPO
+
+import ocpkit
+from ocpkit.bench import paper
+from ocpkit.bench import random as random_suite
+from ocpkit.bench.common import Results
+from ocpkit.cli import _planner_options, parser
+from ocpkit.ladder import DEFAULT_LADDER, NO_PATH_HINT, SINGLE_SHOT, Rung, climb, rank
+from ocpkit.plan import Plan, PlanStats
+from ocpkit.simultaneous import (
+    _fell_back_to_line,
+    _overridden,
+    line_guess,
+    plan_simultaneous,
+)
+from ocpkit.verify import Check, Verification
+
+CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
+
+
+def fake(status: str, worst: float = 0.0, seconds: float = 1.0, iterations: int = 10) -> Plan:
+    """A plan with `status`, one obstacle check of `worst` m (failed if > 0), `seconds` of computation."""
+    check = Check("obstacle", worst, 0.0, 0.5, "m")
+    stats = PlanStats(seconds, 0.5, iterations, 1, f"{status} message", {"own": 1})
+    return Plan(None, status, Verification((check,), np.zeros(0)), stats, {"planner": "fake"})
+
+
+class Script:
+    """An attempt function that returns the scripted plan of each rung and records (rung name, seconds left)."""
+
+    def __init__(self, plans: dict[str, Plan]) -> None:
+        self.plans, self.calls = plans, []
+
+    def __call__(self, rung: Rung | None, left: float) -> Plan:
+        self.calls.append((rung.name if rung else None, left))
+        return self.plans[rung.name if rung else "none"]
+
+
+LADDER = (Rung("a"), Rung("b", guess="ompl", seed=1), Rung("c", knots=16))
+
+
+def test_the_first_verified_rung_wins_and_later_rungs_do_not_run():
+    script = Script({"a": fake("infeasible", seconds=2.0), "b": fake("verified"), "c": fake("verified")})
+    result = climb(script, LADDER, 60.0)
+    assert [name for name, _ in script.calls] == ["a", "b"]
+    assert result.ok and result.method["rung"] == "b"
+    assert result.stats.extra["rungs"] == [{"rung": "a", "status": "infeasible", "time_s": 2.0, "iterations": 10},
+                                           {"rung": "b", "status": "verified", "time_s": 1.0, "iterations": 10}]
+    assert (result.stats.solve_time, result.stats.setup_time, result.stats.iterations) == (3.0, 1.0, 20)
+
+
+def test_without_a_verified_rung_the_smallest_violation_is_the_best():
+    script = Script({"a": fake("violated", 0.02), "b": fake("infeasible"), "c": fake("violated", 0.005)})
+    result = climb(script, LADDER, 60.0)
+    assert result.status == "violated" and result.method["rung"] == "c"
+    assert result.stats.solver_message == "rung c: violated message"
+    extra = result.stats.extra
+    assert extra["own"] == 1 and len(extra["rungs"]) == 3 and extra["skipped"] == []
+
+
+@pytest.mark.parametrize("statuses, best", [(("time_limit", "infeasible", "iteration_limit"), "infeasible"),
+                                            (("failed", "iteration_limit", "time_limit"), "iteration_limit")])
+def test_a_failure_reports_the_best_rungs_status(statuses, best):
+    script = Script({rung.name: fake(status) for rung, status in zip(LADDER, statuses)})
+    assert climb(script, LADDER, 60.0).status == best
+
+
+def test_rank_orders_by_status_then_violation():
+    plans = [fake("time_limit"), fake("violated", 0.3), fake("verified"), fake("infeasible"), fake("violated", 0.1)]
+    assert [(p.status, p.verification.checks[0].worst) for p in sorted(plans, key=rank)] == [
+        ("verified", 0.0), ("violated", 0.1), ("violated", 0.3), ("infeasible", 0.0), ("time_limit", 0.0)]
+
+
+def test_every_rung_gets_the_time_left_and_none_starts_after_the_budget():
+    script = Script({"a": fake("infeasible", seconds=5.0), "b": fake("iteration_limit", seconds=4.0),
+                     "c": fake("verified")})
+    result = climb(script, LADDER, 8.0)
+    assert script.calls == [("a", 8.0), ("b", 3.0)]
+    assert result.status == "infeasible" and result.method["rung"] == "a"
+
+
+def test_an_empty_ladder_is_one_attempt_with_the_calls_options():
+    plan = fake("violated", 0.1)
+    script = Script({"none": plan})
+    assert climb(script, SINGLE_SHOT, 7.0) is plan and script.calls == [(None, 7.0)]
+
+
+def test_a_rung_overrides_only_what_it_names():
+    options = {"guess": "line", "guess_options": {"planning_time": 2.0}, "knots": 12,
+               "transcription_options": {"staged": False}, "solver_options": {"tol": 1e-7}}
+    changed = _overridden(options, Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300))
+    assert changed == {"guess": "ompl", "guess_options": {"seed": 3}, "knots": 16,
+                       "transcription_options": {"staged": False, "segments": 2},
+                       "solver_options": {"tol": 1e-7, "max_iterations": 300}}
+    assert options["knots"] == 12 and options["solver_options"] == {"tol": 1e-7}
+    assert _overridden(options, Rung("same")) == options and _overridden(options, None) is options
+    capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300))
+    assert capped["solver_options"] == {"max_iterations": 50}
+
+
+def test_the_default_ladder_starts_with_the_calls_guess_and_ends_uncapped():
+    assert DEFAULT_LADDER[0].guess is None and DEFAULT_LADDER[-1] == Rung(DEFAULT_LADDER[-1].name)
+    assert len({rung.name for rung in DEFAULT_LADDER}) == len(DEFAULT_LADDER)
+
+
+def test_a_plan_that_verifies_on_the_first_rung_reports_one_rung():
+    result = plan_simultaneous(CASE2, knots=6)
+    assert result.ok and result.method["rung"] == DEFAULT_LADDER[0].name
+    assert [r["rung"] for r in result.stats.extra["rungs"]] == [DEFAULT_LADDER[0].name]
+
+
+def test_the_single_shot_reports_no_rungs():
+    result = plan_simultaneous(CASE2, knots=6, fallbacks=SINGLE_SHOT)
+    assert result.ok and "rungs" not in result.stats.extra and "rung" not in result.method
+
+
+def test_single_shot_on_the_command_line_means_no_fallbacks():
+    args = parser().parse_args(["plan", "x.yaml", "--single-shot"])
+    assert _planner_options(args) == {"fallbacks": ()}
+    assert "fallbacks" not in _planner_options(parser().parse_args(["plan", "x.yaml"]))
+
+
+def test_a_failed_ladder_where_ompl_found_no_path_says_so():
+    script = Script({"a": fake("infeasible"), "b": fake("no_path"), "c": fake("iteration_limit")})
+    result = climb(script, LADDER, 60.0)
+    assert result.status == "infeasible" and result.hint == NO_PATH_HINT
+    assert [r["status"] for r in result.stats.extra["rungs"]] == ["infeasible", "no_path", "iteration_limit"]
+    script = Script({"a": fake("no_path"), "b": fake("verified")})
+    assert climb(script, LADDER, 60.0).hint == ""
+
+
+def test_an_ompl_guess_that_fell_back_to_the_line_is_recognised():
+    discretization = ocpkit.build(CASE2, knots=6).discretization
+    line = line_guess(CASE2, discretization)
+    assert _fell_back_to_line(CASE2, discretization, "ompl", line)
+    assert not _fell_back_to_line(CASE2, discretization, "line", line)
+    assert not _fell_back_to_line(CASE2, discretization, "ompl", line + 1e-3)
+
+
+class Captured(Exception):
+    """Raised by a stand-in planner with the options it was given."""
+
+
+def capture(*args, **options):
+    raise Captured(options)
+
+
+def test_the_random_bench_passes_its_ladder_to_the_planner(monkeypatch):
+    monkeypatch.setattr(random_suite, "plan", capture)
+    with pytest.raises(Captured) as caught:
+        random_suite.run_random(1, 1, fallbacks=SINGLE_SHOT)
+    assert caught.value.args[0]["fallbacks"] == SINGLE_SHOT
+    with pytest.raises(Captured) as caught:
+        random_suite.run_random(1, 1)
+    assert caught.value.args[0]["fallbacks"] == DEFAULT_LADDER
+
+
+def test_the_paper_bench_plans_single_shot(monkeypatch, tmp_path):
+    monkeypatch.setattr(paper, "measure", capture)
+    bench = paper._Bench(Results(tmp_path / "results.csv"), tmp_path, 1, "chebyshev", {})
+    with pytest.raises(Captured) as caught:
+        bench.simultaneous("paper", CASE2, 6, "casadi-rnea", guess="ompl")
+    assert caught.value.args[0]["fallbacks"] == SINGLE_SHOT and caught.value.args[0]["guess"] == "ompl"
+
+
+CAPPED = (Rung("capped", max_iterations=300), Rung("other", guess="ompl"), Rung("uncapped"))
+
+
+@pytest.mark.parametrize("first, runs", [("infeasible", ["capped", "other"]),
+                                         ("iteration_limit", ["capped", "other", "uncapped"])])
+def test_an_uncapped_repeat_runs_only_after_the_cap_was_hit(first, runs):
+    script = Script({"capped": fake(first), "other": fake("no_path"), "uncapped": fake("violated", 0.1)})
+    result = climb(script, CAPPED, 60.0)
+    assert [name for name, _ in script.calls] == runs
+    assert result.stats.extra["skipped"] == ([] if "uncapped" in runs else ["uncapped"])
