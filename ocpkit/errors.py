@@ -22,6 +22,11 @@ class RegistryError(OcpkitError):
     """A component name (transcription, dynamics, solver, planner) is not registered."""
 
 
+class NoGuess(Exception):
+    """An initial-guess rule asked not to fall back (`fallback=False`) has no start of its own to offer (OMPL found
+    no path): not a user mistake, a finding the planner reports as `no_path`."""
+
+
 class OptionError(OcpkitError):
     """A planner, transcription or solver option is out of range."""
 

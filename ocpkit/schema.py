@@ -1,7 +1,7 @@
 """The scenario and robot-spec file formats as one declarative schema, checked recursively before any use.
 
 A schema is a tree of nodes: `Mapping` (required and optional keys; any other key is an error), `Sequence`
-(element node, optional exact or minimum length), `Number` (finite, not a boolean, optional sign), `Integer`,
+(element node, optional exact or minimum length), `Number` (finite, not a boolean, optional sign, optionally integer),
 `String`, `Choice` (one of some values), `Tagged` (a one-key mapping `{kind: body}`, e.g. an obstacle
 `{sphere: {...}}`; new kinds are new entries) and `OneOf` (the first option whose type fits the value).
 `check(data, node, error)` walks it and raises `error` naming the full path of the offending field
@@ -15,6 +15,7 @@ import math
 import numbers
 import operator
 import reprlib
+from abc import ABC, abstractmethod
 from collections.abc import Sequence as SequenceABC
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -52,15 +53,16 @@ def _label(path: str) -> str:
     return path or "the file"
 
 
-class Node:
+class Node(ABC):
     """A schema node: `fits` says whether the value has the right type, `_check_inside` checks its content."""
 
+    @abstractmethod
     def describe(self) -> str:
         """What a fitting value is, for messages: 'a number'."""
-        raise NotImplementedError
 
+    @abstractmethod
     def fits(self, value: Any) -> bool:
-        raise NotImplementedError
+        """Whether `value` has this node's type."""
 
     def check(self, value: Any, path: str) -> None:
         """Raise _Invalid naming `path` if `value` does not match this node."""
@@ -74,35 +76,22 @@ class Node:
 
 @dataclass(frozen=True)
 class Number(Node):
-    """A finite real number (booleans are not numbers); `sign` 'positive' (> 0) or 'non-negative' (≥ 0)."""
+    """A finite real number, or with `integer` an integer (not 1.0); booleans are neither. `sign` 'positive'
+    (> 0) or 'non-negative' (≥ 0)."""
 
     sign: Sign | None = None
+    integer: bool = False
 
     def describe(self) -> str:
-        return "a number"
+        return "an integer" if self.integer else "a number"
 
     def fits(self, value: Any) -> bool:
-        return isinstance(value, numbers.Real) and not isinstance(value, bool)
+        kind = numbers.Integral if self.integer else numbers.Real
+        return isinstance(value, kind) and not isinstance(value, bool)
 
     def _check_inside(self, value: Any, path: str) -> None:
         if not _finite(value):
             raise _Invalid(f"{_label(path)} must be finite, got {show(value)}")
-        _check_sign(self.sign, value, path)
-
-
-@dataclass(frozen=True)
-class Integer(Node):
-    """An integer (not a boolean, not 1.0); `sign` as for Number."""
-
-    sign: Sign | None = None
-
-    def describe(self) -> str:
-        return "an integer"
-
-    def fits(self, value: Any) -> bool:
-        return isinstance(value, numbers.Integral) and not isinstance(value, bool)
-
-    def _check_inside(self, value: Any, path: str) -> None:
         _check_sign(self.sign, value, path)
 
 
@@ -299,7 +288,7 @@ SPEC = Mapping(
     optional={
         "spheres": Sequence(Mapping(required={"link": String(), "center": vector(length=3),
                                               "radius": Number("positive")})),
-        "self_collision": Sequence(Sequence(Integer("non-negative"), length=2)),
+        "self_collision": Sequence(Sequence(Number("non-negative", integer=True), length=2)),
     },
 )
 """A robot spec.yaml (README, 'Robot files'); every vector has one value per joint (checked on loading)."""

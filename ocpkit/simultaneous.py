@@ -15,7 +15,7 @@ import numpy as np
 from ocpkit.build_cache import build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
 from ocpkit.dynamics import Dynamics
-from ocpkit.errors import OptionError
+from ocpkit.errors import NoGuess, OptionError
 from ocpkit.ladder import DEFAULT_LADDER, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
@@ -25,8 +25,9 @@ from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization
 
 
-def line_guess(problem: Problem, discretization: Discretization) -> np.ndarray:
-    """The straight joint-space line from start to goal over t_f = time.guess (the paper's initial guess)."""
+def line_guess(problem: Problem, discretization: Discretization, fallback: bool = True) -> np.ndarray:
+    """The straight joint-space line from start to goal over t_f = time.guess (the paper's initial guess); it always
+    exists, so `fallback` (every guess rule takes it: see NoGuess) changes nothing."""
     return discretization.initial_guess(problem)
 
 
@@ -53,21 +54,21 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
                "guess": guess, "refinements": refinements, "constraints": constraints,
                "transcription_options": transcription_options or {}, "solver_options": solver_options or {},
                "dynamics_options": dynamics_options, "guess_options": guess_options or {}}
-    return climb(lambda rung, left: _single_shot(problem, _overridden(options, rung), left,
-                                                 skip_without_path=rung is not None and rung.guess is not None),
-                 fallbacks, max_wall_time)
+    return climb(lambda rung, left: _single_shot(problem, _overridden(options, rung), left), fallbacks,
+                 max_wall_time)
 
 
 def _overridden(options: dict, rung: Rung | None) -> dict:
     """The options of `plan_simultaneous` with `rung`'s overrides applied (`options` itself for None); a rung's
-    guess comes with its own options (its seed) instead of the call's; the call's own max_iterations wins over a
-    rung's cap."""
+    guess comes with its own options (its seed, and no fallback to the straight line: a rung without a start of
+    its own ends `no_path` instead of repeating the line) instead of the call's; the call's own max_iterations
+    wins over a rung's cap."""
     if rung is None:
         return options
     changed = dict(options)
     if rung.guess is not None:
         changed["guess"] = rung.guess
-        changed["guess_options"] = {} if rung.seed is None else {"seed": rung.seed}
+        changed["guess_options"] = {"fallback": False, **({} if rung.seed is None else {"seed": rung.seed})}
     if rung.knots is not None:
         changed["knots"] = rung.knots
     if rung.segments is not None:
@@ -77,35 +78,30 @@ def _overridden(options: dict, rung: Rung | None) -> dict:
     return changed
 
 
-def _single_shot(problem: Problem, options: dict, max_wall_time: float, skip_without_path: bool = False) -> Plan:
+def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     """One plan with `options` (those of `plan_simultaneous`): build, guess, solve with refinement rounds, all
-    within `max_wall_time` (s) of computation. With `skip_without_path`, a guess rule other than "line" that
-    found no path (it gave the straight line instead) ends the plan as `no_path` before any solve."""
+    within `max_wall_time` (s) of computation. A guess rule with no start to offer (NoGuess) ends the plan as
+    `no_path` before any solve."""
     started = time.perf_counter()
     made = build(problem, options["transcription"], options["knots"], options["dynamics"], options["solver"],
                  options["constraints"], options["transcription_options"], options["solver_options"],
                  options["dynamics_options"])
     deadline = time.perf_counter() + max_wall_time
-    w = _guess(problem, made.discretization, options["guess"], options["guess_options"])
     dynamics = options["dynamics"]
     method = {"planner": "simultaneous", "transcription": options["transcription"], "knots": options["knots"],
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options["solver"]}
-    if skip_without_path and _fell_back_to_line(problem, made.discretization, options["guess"], w):
-        return finish(problem, made.discretization.decode(w), "no_path", method, started, setup_time=made.setup_time,
-                      message=f"guess {options['guess']!r} found no path (it gave the straight line): not solved")
+    try:
+        w = _guess(problem, made.discretization, options["guess"], options["guess_options"])
+    except NoGuess as exc:
+        line = made.discretization.decode(line_guess(problem, made.discretization))
+        return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
+                      message=f"guess {options['guess']!r}: {exc}; not solved")
     refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline)
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=made.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
                   verification=refined.verification)
-
-
-def _fell_back_to_line(problem: Problem, discretization: Discretization, guess: str | np.ndarray,
-                       w: np.ndarray) -> bool:
-    """Whether the named guess rule `guess`, other than "line", gave the straight-line guess w (n_w,) (the "ompl"
-    rule does when OMPL finds no path)."""
-    return isinstance(guess, str) and guess != "line" and np.array_equal(w, line_guess(problem, discretization))
 
 
 def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray, options: dict) -> np.ndarray:

@@ -8,14 +8,16 @@ import pytest
 from helpers import REPO
 
 import ocpkit
+from ocpkit.baselines.ompl_toppra import ompl_guess
 from ocpkit.bench import paper
 from ocpkit.bench import random as random_suite
 from ocpkit.bench.common import Results
 from ocpkit.cli import _planner_options, parser
+from ocpkit.errors import NoGuess
 from ocpkit.ladder import DEFAULT_LADDER, NO_PATH_HINT, SINGLE_SHOT, Rung, climb, rank
 from ocpkit.plan import Plan, PlanStats
+from ocpkit.planner import GUESSES
 from ocpkit.simultaneous import (
-    _fell_back_to_line,
     _overridden,
     line_guess,
     plan_simultaneous,
@@ -96,7 +98,7 @@ def test_a_rung_overrides_only_what_it_names():
     options = {"guess": "line", "guess_options": {"planning_time": 2.0}, "knots": 12,
                "transcription_options": {"staged": False}, "solver_options": {"tol": 1e-7}}
     changed = _overridden(options, Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300))
-    assert changed == {"guess": "ompl", "guess_options": {"seed": 3}, "knots": 16,
+    assert changed == {"guess": "ompl", "guess_options": {"fallback": False, "seed": 3}, "knots": 16,
                        "transcription_options": {"staged": False, "segments": 2},
                        "solver_options": {"tol": 1e-7, "max_iterations": 300}}
     assert options["knots"] == 12 and options["solver_options"] == {"tol": 1e-7}
@@ -136,12 +138,12 @@ def test_a_failed_ladder_where_ompl_found_no_path_says_so():
     assert climb(script, LADDER, 60.0).hint == ""
 
 
-def test_an_ompl_guess_that_fell_back_to_the_line_is_recognised():
+def test_an_ompl_guess_without_a_path_falls_back_to_the_line_only_when_asked():
     discretization = ocpkit.build(CASE2, knots=6).discretization
     line = line_guess(CASE2, discretization)
-    assert _fell_back_to_line(CASE2, discretization, "ompl", line)
-    assert not _fell_back_to_line(CASE2, discretization, "line", line)
-    assert not _fell_back_to_line(CASE2, discretization, "ompl", line + 1e-3)
+    np.testing.assert_array_equal(ompl_guess(CASE2, discretization, planning_time=0.0), line)
+    with pytest.raises(NoGuess, match="no_path"):
+        ompl_guess(CASE2, discretization, fallback=False, planning_time=0.0)
 
 
 class Captured(Exception):
@@ -180,3 +182,12 @@ def test_an_uncapped_repeat_runs_only_after_the_cap_was_hit(first, runs):
     result = climb(script, CAPPED, 60.0)
     assert [name for name, _ in script.calls] == runs
     assert result.stats.extra["skipped"] == ([] if "uncapped" in runs else ["uncapped"])
+
+
+def test_a_rung_whose_guess_has_no_start_ends_no_path_before_any_solve(monkeypatch):
+    def nothing(problem, discretization, fallback=True):
+        raise NoGuess("no start here")
+
+    monkeypatch.setitem(GUESSES._items, "nothing", nothing)
+    plan = plan_simultaneous(CASE2, knots=6, fallbacks=(Rung("n", guess="nothing"),))
+    assert plan.status == "no_path" and plan.stats.iterations == 0 and "no start here" in plan.stats.solver_message

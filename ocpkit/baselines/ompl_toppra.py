@@ -45,15 +45,15 @@ OMPL and toppra are optional dependencies, imported on first use (toppra is slow
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
-from collections.abc import Iterator
 
 import numpy as np
 import pinocchio as pin
 
-from ocpkit.errors import RegistryError
+from ocpkit.errors import NoGuess, RegistryError
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.plan import Plan, finish
 from ocpkit.problem import Problem
@@ -365,12 +365,16 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     return done(Trajectory(interpolant(knot_times), interpolant), None, message)
 
 
-def ompl_guess(problem: Problem, discretization: Discretization, **baseline_options: Any) -> np.ndarray:
+def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool = True,
+               **baseline_options: Any) -> np.ndarray:
     """A warm start: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`) sampled on the
-    discretization's grid by `encode`; its own straight-line guess if the baseline has no trajectory."""
+    discretization's grid by `encode`. Without a baseline trajectory: the straight-line guess with `fallback`,
+    else NoGuess."""
     baseline = plan_ompl_toppra(problem, **baseline_options)
-    if baseline.status in ("no_path", "infeasible"):
+    if baseline.status not in ("no_path", "infeasible"):
+        return discretization.encode(baseline.trajectory)
+    if fallback:
         return discretization.initial_guess(problem)
-    return discretization.encode(baseline.trajectory)
+    raise NoGuess(f"OMPL + TOPP-RA gave no trajectory ({baseline.status}: {baseline.stats.solver_message})")
 
 

@@ -12,6 +12,7 @@ for as long as it wants to reuse it; solvers cache nothing.
 
 from __future__ import annotations
 
+import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from enum import Enum
@@ -56,6 +57,17 @@ class SolverResult:
     stats: dict = field(default_factory=dict, repr=False)
     lam_g: np.ndarray | None = field(default=None, repr=False)
     lam_x: np.ndarray | None = field(default=None, repr=False)
+
+    @classmethod
+    def failed(cls, guess: np.ndarray, started: float, message: str) -> SolverResult:
+        """A solve that ended abnormally (an exception, not a status): the guess back, no iterations, the wall
+        time since `started` (time.perf_counter s)."""
+        return cls(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0, time.perf_counter() - started, message)
+
+
+def time_limit(own: float, given: float | None) -> float:
+    """The wall-time limit (s) of one call: `given` if there is one, else the solver's `own`."""
+    return own if given is None else given
 
 
 class PreparedSolver(ABC):

@@ -30,7 +30,8 @@ import numpy as np
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP, Stages
-from ocpkit.solvers.base import BOUND_TOLERANCE, PreparedSolver, Solver, SolverResult, SolverStatus, bound_slack
+from ocpkit.solvers.base import (BOUND_TOLERANCE, PreparedSolver, Solver, SolverResult, SolverStatus, bound_slack,
+                                 time_limit)
 
 _UNIFIED_STATUS = {
     "SOLVER_RET_SUCCESS": SolverStatus.CONVERGED,
@@ -133,7 +134,7 @@ class PreparedNlpsol(PreparedSolver):
               max_wall_time: float | None = None) -> SolverResult:
         """See `PreparedSolver.solve`; blocksqp and fatrop cannot be stopped at `max_wall_time` (module docstring)."""
         start = time.perf_counter()
-        limit = self.owner.max_wall_time if max_wall_time is None else max_wall_time
+        limit = time_limit(self.owner.max_wall_time, max_wall_time)
         if self.deadline is not None:
             self.deadline.arm(start + limit, *(np.asarray(b, dtype=float) for b in bounds))
         try:
@@ -142,8 +143,7 @@ class PreparedNlpsol(PreparedSolver):
                                     lbg=self.nlp.lbg, ubg=self.nlp.ubg)
             stats = self.function.stats()
         except RuntimeError as exc:  # a plugin's assertion or failed evaluation: a status, not a crash
-            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
-                                time.perf_counter() - start, str(exc))
+            return SolverResult.failed(guess, start, str(exc))
         wall = time.perf_counter() - start
         message = str(stats.get("return_status", stats.get("unified_return_status", "unknown")))
         stopped = self.deadline.reason if self.deadline is not None else ""

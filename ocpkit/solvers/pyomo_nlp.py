@@ -62,7 +62,7 @@ from pyomo.opt import SolverStatus as PyomoStatus
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP
-from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus, time_limit
 from ocpkit.solvers.casadi_nlpsol import hessian_approximation
 
 _UNARY: dict[int, Callable] = {
@@ -268,7 +268,7 @@ class PreparedRipopt(PreparedSolver):
               max_wall_time: float | None = None) -> SolverResult:
         guess = np.asarray(guess, dtype=float)
         self.translation.load(guess, np.asarray(params, dtype=float), *(np.asarray(b, dtype=float) for b in bounds))
-        limit = self.owner.max_wall_time if max_wall_time is None else max_wall_time
+        limit = time_limit(self.owner.max_wall_time, max_wall_time)
         options = {"hessian_approximation": hessian_approximation(self.nlp), **self.owner.options,
                    "max_wall_time": limit}
         start = time.perf_counter()
@@ -278,8 +278,7 @@ class PreparedRipopt(PreparedSolver):
             wall = time.perf_counter() - start
             return SolverResult(guess, SolverStatus.TIME_LIMIT, 0, wall, f"ripopt killed after {wall:.1f} s")
         except (ApplicationError, OSError, ValueError) as exc:  # ripopt ended abnormally or wrote no solution
-            return SolverResult(guess, SolverStatus.FAILED, 0, time.perf_counter() - start,
-                                f"{type(exc).__name__}: {exc}")
+            return SolverResult.failed(guess, start, f"{type(exc).__name__}: {exc}")
         wall = time.perf_counter() - start
         message, stats = _message(results), _diagnostics(log)
         w, lam_g = self.translation.solution() if results.solver.status in _LOADED else (guess, None)

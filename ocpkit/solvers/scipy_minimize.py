@@ -22,7 +22,7 @@ import numpy as np
 import scipy.optimize as so
 
 from ocpkit.nlp import NLP
-from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus, time_limit
 from ocpkit.solvers.nlp_functions import NLPFunctions
 
 
@@ -98,10 +98,9 @@ class PreparedMinimize(PreparedSolver):
                                  hess=reduced.objective_hessian() if owner.hessians else None,
                                  bounds=so.Bounds(lbx[free], ubx[free]),
                                  constraints=owner.constraints(self.nlp, reduced), options=owner.options,
-                                 callback=_Clock(owner.max_wall_time if max_wall_time is None else max_wall_time))
+                                 callback=_Clock(time_limit(owner.max_wall_time, max_wall_time)))
         except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:  # failed evaluation or factorization
-            return SolverResult(np.asarray(guess, dtype=float), SolverStatus.FAILED, 0,
-                                time.perf_counter() - start, f"{type(exc).__name__}: {exc}")
+            return SolverResult.failed(guess, start, f"{type(exc).__name__}: {exc}")
         wall = time.perf_counter() - start
         status = owner.statuses.get(int(result.status), SolverStatus.FAILED)
         return SolverResult(reduced.full(result.x), status, int(getattr(result, "nit", 0)), wall,

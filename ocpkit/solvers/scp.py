@@ -65,7 +65,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ocpkit.nlp import NLP
-from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus, time_limit
 from ocpkit.solvers.nlp_functions import NLPFunctions
 
 ACCEPT, POOR, GOOD = 0.1, 0.25, 0.75
@@ -420,7 +420,7 @@ class PreparedScp(PreparedSolver):
             else _DampedBfgs(self.nlp.x.numel())
         start = time.perf_counter()
         run = _Run(self, params, bounds, curvature,
-                   self.settings.max_wall_time if max_wall_time is None else max_wall_time)
+                   time_limit(self.settings.max_wall_time, max_wall_time))
         try:
             point, status, message = run.run(np.asarray(guess, dtype=float))
         except cp.error.SolverError as exc:
