@@ -26,12 +26,14 @@ from dataclasses import dataclass
 from ocpkit.plan import Plan, PlanStats
 
 MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
+OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path (about 20 s on one core)
 
 
 @dataclass(frozen=True)
 class Rung:
     """Option overrides of one attempt: `guess` ("line", "ompl" or None for the call's), OMPL `seed`, `knots`
-    and pseudospectral `segments` (None: the call's), and `max_iterations` per solve (None: the solver's)."""
+    and pseudospectral `segments` (None: the call's), and `max_iterations` per solve (None: the solver's). An
+    "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's time is up."""
 
     name: str
     guess: str | None = None

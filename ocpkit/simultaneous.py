@@ -16,7 +16,7 @@ from ocpkit.build_cache import build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
-from ocpkit.ladder import DEFAULT_LADDER, Rung, climb
+from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
@@ -54,21 +54,23 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
                "guess": guess, "refinements": refinements, "constraints": constraints,
                "transcription_options": transcription_options or {}, "solver_options": solver_options or {},
                "dynamics_options": dynamics_options, "guess_options": guess_options or {}}
-    return climb(lambda rung, left: _single_shot(problem, _overridden(options, rung), left), fallbacks,
+    return climb(lambda rung, left: _single_shot(problem, _overridden(options, rung, left), left), fallbacks,
                  max_wall_time)
 
 
-def _overridden(options: dict, rung: Rung | None) -> dict:
+def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
     """The options of `plan_simultaneous` with `rung`'s overrides applied (`options` itself for None); a rung's
     guess comes with its own options (its seed, and no fallback to the straight line: a rung without a start of
-    its own ends `no_path` instead of repeating the line) instead of the call's; the call's own max_iterations
-    wins over a rung's cap."""
+    its own ends `no_path` instead of repeating the line; an "ompl" rung's search budget, OMPL_CHECKS or the `left`
+    seconds of the ladder) instead of the call's; the call's own max_iterations wins over a rung's cap."""
     if rung is None:
         return options
     changed = dict(options)
     if rung.guess is not None:
         changed["guess"] = rung.guess
-        changed["guess_options"] = {"fallback": False, **({} if rung.seed is None else {"seed": rung.seed})}
+        changed["guess_options"] = {"fallback": False, **({} if rung.seed is None else {"seed": rung.seed}),
+                                    **({"max_checks": OMPL_CHECKS, "planning_time": left} if rung.guess == "ompl"
+                                       else {})}
     if rung.knots is not None:
         changed["knots"] = rung.knots
     if rung.segments is not None:

@@ -14,7 +14,7 @@ from ocpkit.bench import random as random_suite
 from ocpkit.bench.common import Results
 from ocpkit.cli import _planner_options, parser
 from ocpkit.errors import NoGuess
-from ocpkit.ladder import DEFAULT_LADDER, NO_PATH_HINT, SINGLE_SHOT, Rung, climb, rank
+from ocpkit.ladder import DEFAULT_LADDER, NO_PATH_HINT, OMPL_CHECKS, SINGLE_SHOT, Rung, climb, rank
 from ocpkit.plan import Plan, PlanStats
 from ocpkit.planner import GUESSES
 from ocpkit.simultaneous import (
@@ -97,13 +97,16 @@ def test_an_empty_ladder_is_one_attempt_with_the_calls_options():
 def test_a_rung_overrides_only_what_it_names():
     options = {"guess": "line", "guess_options": {"planning_time": 2.0}, "knots": 12,
                "transcription_options": {"staged": False}, "solver_options": {"tol": 1e-7}}
-    changed = _overridden(options, Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300))
-    assert changed == {"guess": "ompl", "guess_options": {"fallback": False, "seed": 3}, "knots": 16,
+    changed = _overridden(options, Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300), 9.0)
+    assert changed == {"guess": "ompl", "guess_options": {"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
+                                                          "planning_time": 9.0}, "knots": 16,
                        "transcription_options": {"staged": False, "segments": 2},
                        "solver_options": {"tol": 1e-7, "max_iterations": 300}}
     assert options["knots"] == 12 and options["solver_options"] == {"tol": 1e-7}
-    assert _overridden(options, Rung("same")) == options and _overridden(options, None) is options
-    capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300))
+    assert _overridden(options, Rung("same"), 9.0) == options and _overridden(options, None, 9.0) is options
+    line = _overridden(options, Rung("line", guess="line"), 9.0)
+    assert line["guess_options"] == {"fallback": False}
+    capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300), 9.0)
     assert capped["solver_options"] == {"max_iterations": 50}
 
 

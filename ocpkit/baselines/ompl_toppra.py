@@ -53,7 +53,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ocpkit.errors import NoGuess, RegistryError
+from ocpkit.errors import NoGuess, OptionError, RegistryError
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.plan import Plan, finish
 from ocpkit.problem import Problem
@@ -102,6 +102,12 @@ class FreeSpace:
                 return False
             done, size = done + size, 2 * size
         return True
+
+
+def _free_space(problem: Problem, margin: float) -> FreeSpace:
+    """The free space of `problem` with `margin` (m), lowered to the start's or goal's clearance if that is smaller."""
+    ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
+    return FreeSpace(problem, min(margin, float(ends.min())))
 
 
 def _coarse_to_fine(count: int) -> np.ndarray:
@@ -167,6 +173,17 @@ def _state(si: Any, q: np.ndarray) -> Any:
     return state
 
 
+def _termination(ob: Any, free: FreeSpace, planning_time: float, max_checks: int | None) -> Any:
+    """OMPL's termination condition: `planning_time` s passed (not with inf, which OMPL's timer cannot take) or
+    more than `max_checks` configurations checked by `free` (not with None)."""
+    if max_checks is None:
+        return ob.timedPlannerTerminationCondition(planning_time)
+    budget = ob.PlannerTerminationCondition(lambda: free.checks > max_checks)
+    if np.isinf(planning_time):
+        return budget
+    return ob.plannerOrTerminationCondition(ob.timedPlannerTerminationCondition(planning_time), budget)
+
+
 @dataclass(frozen=True)
 class _OmplResult:
     """Simplified waypoints (k, n) from start to goal, or None without an exact path; times in seconds."""
@@ -177,16 +194,20 @@ class _OmplResult:
 
 
 def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
-               resolution: float) -> _OmplResult:
-    """Plan start → goal with the named OMPL planner until it stops with an exact path or `planning_time`
-    seconds have passed, then simplify the path to convergence.
+               resolution: float, max_checks: int | None = None) -> _OmplResult:
+    """Plan start → goal with the named OMPL planner until it stops with an exact path, `planning_time` seconds
+    have passed or (if given) `free` has checked more than `max_checks` configurations, then simplify the path to
+    convergence. A budget in checks repeats on any machine; one in seconds does not.
 
-    The budget is OMPL's own timer, not a Python callable: PRM checks for a solution in a second thread,
-    which would deadlock waiting for the interpreter lock that the planning thread holds."""
+    The time budget is OMPL's own timer. A check budget is a Python condition, safe only for planners that plan in
+    the calling thread (RRTConnect, RRT*, BIT*): PRM checks for a solution in a second thread, which would deadlock
+    waiting for the interpreter lock that the planning thread holds."""
     import ompl.base as ob
     import ompl.geometric as og
     import ompl.util as ou
 
+    if max_checks is not None and planner_name == "prm":
+        raise OptionError("max_checks cannot stop prm (it plans in a second thread); give it a planning_time")
     with _ompl_log_level(ou, ou.LOG_ERROR):
         _seed_ompl(ou, seed)
         si = _space_information(problem, free, resolution)
@@ -194,7 +215,8 @@ def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_ti
         setup.setStartAndGoalStates(_state(si, problem.start), _state(si, problem.goal))
         setup.setPlanner(getattr(og, OMPL_PLANNERS[planner_name])(si))
         start = time.perf_counter()
-        setup.solve(ob.timedPlannerTerminationCondition(planning_time))
+        stop = _termination(ob, free, planning_time, max_checks)
+        setup.solve(stop)
         path_time = time.perf_counter() - start
         if not setup.haveExactSolutionPath():
             return _OmplResult(None, path_time, 0.0)
@@ -315,7 +337,8 @@ def _import_backends() -> float:
 
 
 def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
-                     resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01) -> Plan:
+                     resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
+                     max_checks: int | None = None) -> Plan:
     """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (see the module docstring).
 
     `planner_name`: one of OMPL_PLANNERS. `planning_time` (s): OMPL's budget. RRTConnect stops at its first
@@ -323,6 +346,8 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     watches for a solution in a second thread, so their paths may depend on machine speed. `resolution` (rad):
     spacing of collision checks along straight joint-space segments. `grid_points`: TOPP-RA's path points.
     `margin` (m): clearance kept while planning, lowered to the start's or goal's clearance if that is smaller.
+    `max_checks`: OMPL stops after checking this many configurations too (a budget that repeats on any machine;
+    planning_time may then be inf; only for the planners that plan in the calling thread, not PRM).
 
     Status: "verified" or "violated" (dense `verify`), "no_path" (OMPL found no exact path in its budget) or
     "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start (`Plan.found`
@@ -335,9 +360,8 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     if np.array_equal(problem.start, problem.goal):
         return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
     setup = _import_backends()
-    ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
-    free = FreeSpace(problem, min(margin, float(ends.min())))
-    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution)
+    free = _free_space(problem, margin)
+    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks)
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
              "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,
              "margin_m": free.margin}
@@ -348,7 +372,7 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
 
     if found.waypoints is None:
         return done(_hold(problem), "no_path", f"{planner_name}: no exact path within {planning_time:g} s "
-                    f"({free.checks} validity checks); no trajectory: the plan holds the start", found=False)
+                    f"and {free.checks} validity checks; no trajectory: the plan holds the start", found=False)
     smoothing = time.perf_counter()
     path, rounds = _smooth_path(found.waypoints, free, resolution)
     timing = time.perf_counter()
@@ -363,6 +387,15 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; "
                f"TOPP-RA: {grid_points} grid points")
     return done(Trajectory(interpolant(knot_times), interpolant), None, message)
+
+
+def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
+               resolution: float = 0.01, margin: float = 0.01, max_checks: int | None = None) -> np.ndarray | None:
+    """The baseline's simplified collision-free joint-space path (waypoints (k, n), rad) from start to goal, or None
+    if the OMPL planner found none within `planning_time` s and `max_checks` configurations checked (options as for
+    `plan_ompl_toppra`)."""
+    free = _free_space(problem, margin)
+    return _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks).waypoints
 
 
 def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool = True,

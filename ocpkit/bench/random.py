@@ -5,9 +5,14 @@ Each problem has a random start and goal inside most of the joint range and obst
 the paper cases' workspace. With `obstacles=(1, 1)` (the original suite) that is one sphere near the wrist's
 position halfway along the straight joint-space path. With another range (lo, hi) it is lo..hi spheres of
 radius RADII, each near a different robot sphere of PATH_SPHERES at a random point of that path. Problems
-whose start or goal is invalid are redrawn. Prints one line per problem (with the hint of a plan that did not
-verify), then the status counts and the median and 90th-percentile computation time of the verified plans;
-with `out`, also results.csv, the trajectory JSONs and each problem's scenario YAML (for tests/outside_check.py).
+whose start or goal is invalid are redrawn, and so are problems whose obstacles leave no room to pass: a problem
+counts only once RRTConnect (seed PATH_SEED, at most PATH_CHECKS configurations checked, the planners' 0.01 m
+margin) has connected its start and goal. That certificate is a budget in collision checks, not seconds, so the
+same seed gives the same problems on any machine; the planners under test never see its path.
+
+Prints one line per problem (with the hint of a plan that did not verify), then the status counts and the
+median and 90th-percentile computation time of the verified plans; with `out`, also results.csv, the trajectory
+JSONs and each problem's scenario YAML (for tests/outside_check.py).
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ocpkit.baselines.ompl_toppra import joint_path
 from ocpkit.bench.common import machine
 from ocpkit.errors import ScenarioError
 from ocpkit.geometry import sphere_centers
@@ -42,11 +48,15 @@ RADII = (0.08, 0.22)  # m, each sphere of the other suites
 PATH_SPHERES = np.arange(4, 15)  # robot spheres that obstacles are placed near: upper arm to flange
 PATH_FRACTIONS = (0.2, 0.8)  # where along the straight path
 OFFSET = 0.1  # m, standard deviation of an obstacle's offset from its robot sphere
+PATH_SEED = 1000  # OMPL seed of the room-to-pass certificate (unlike the planners' seeds 0, 1, 2, ...)
+PATH_CHECKS = 1_500_000  # configurations the certificate may check (about 20 s on one core)
 
 
-def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1)) -> Iterator[Problem]:
+def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
+                    room_to_pass: bool = True) -> Iterator[Problem]:
     """`count` valid random problems for industrial6 with obstacles[0]..obstacles[1] obstacle spheres,
-    deterministic in `seed` (module docstring)."""
+    deterministic in `seed`, each with a certified collision-free path unless `room_to_pass` is False (module
+    docstring)."""
     rng = np.random.default_rng(seed)
     robot = load_robot("industrial6")
     lower, upper = np.radians(LOWER_DEG), np.radians(UPPER_DEG)
@@ -58,6 +68,8 @@ def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1)) 
         try:
             validate(problem)
         except ScenarioError:
+            continue
+        if room_to_pass and joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS) is None:
             continue
         count -= 1
         yield problem

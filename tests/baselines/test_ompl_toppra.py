@@ -90,6 +90,14 @@ def test_no_path_within_the_budget_is_a_status_and_the_robot_holds_still(case1):
     assert not {c.name: c for c in plan.verification.checks}["boundary"].ok  # the goal is not reached
 
 
+def test_a_budget_in_checks_stops_the_search_without_a_timer(case1):
+    plan = plan_ompl_toppra(case1, planning_time=np.inf, max_checks=0)
+    assert plan.status == "no_path" and "validity checks" in plan.stats.solver_message
+    assert plan.stats.extra["validity_checks"] < 1000  # checked between OMPL's steps: at most one segment late
+    with pytest.raises(OptionError, match="prm"):
+        plan_ompl_toppra(case1, planner_name="prm", max_checks=50)
+
+
 @pytest.mark.slow
 def test_seeded_runs_repeat_exactly(case1):
     first, second = (plan_ompl_toppra(case1, seed=3) for _ in range(2))

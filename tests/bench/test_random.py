@@ -19,8 +19,8 @@ def test_the_original_suite_keeps_its_problems():
 
 
 def test_more_obstacles_are_seeded_and_within_the_range():
-    problems = list(random_problems(100, 30, (1, 3)))
-    again = list(random_problems(100, 30, (1, 3)))
+    problems = list(random_problems(100, 30, (1, 3), room_to_pass=False))
+    again = list(random_problems(100, 30, (1, 3), room_to_pass=False))
     counts = [len(p.scene.obstacle_radii) for p in problems]
     assert set(counts) == {1, 2, 3}
     assert all(np.array_equal(p.scene.obstacle_centers, q.scene.obstacle_centers) for p, q in zip(problems, again))
@@ -30,7 +30,7 @@ def test_more_obstacles_are_seeded_and_within_the_range():
 
 def test_the_obstacles_are_in_the_way_of_the_straight_path():
     """Each problem's straight joint-space path passes within 0.3 m of every obstacle with some robot sphere."""
-    for problem in random_problems(100, 10, (2, 3)):
+    for problem in random_problems(100, 10, (2, 3), room_to_pass=False):
         path = np.linspace(problem.start, problem.goal, 41)
         centres = sphere_centers(problem.robot, path)[:, PATH_SPHERES]  # (41, k, 3)
         for obstacle in problem.scene.obstacle_centers:
@@ -38,6 +38,25 @@ def test_the_obstacles_are_in_the_way_of_the_straight_path():
         ends = clearances(problem.robot, problem.scene, sphere_centers(problem.robot, np.stack([problem.start,
                                                                                                problem.goal])))
         assert ends.smallest() >= 0.0
+
+
+def test_problems_without_room_to_pass_are_redrawn(monkeypatch):
+    """A problem whose certificate finds no path is replaced by the next draw; the others are kept as drawn."""
+    drawn = list(random_problems(100, 3, (1, 3), room_to_pass=False))
+    certified = list(random_problems(100, 2, (1, 3)))
+    assert [p.name for p in certified] == ["random2", "random1"]
+    np.testing.assert_array_equal(certified[0].start, drawn[0].start)
+    calls = []
+
+    def no_path_first(problem, **options):
+        calls.append(options)
+        return None if len(calls) == 1 else np.stack([problem.start, problem.goal])
+
+    monkeypatch.setattr(suite, "joint_path", no_path_first)
+    redrawn = list(random_problems(100, 2, (1, 3)))
+    np.testing.assert_array_equal(redrawn[0].start, drawn[1].start)
+    np.testing.assert_array_equal(redrawn[1].start, drawn[2].start)
+    assert calls[0]["seed"] == suite.PATH_SEED and calls[0]["max_checks"] == suite.PATH_CHECKS
 
 
 @pytest.mark.slow
