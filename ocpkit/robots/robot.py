@@ -163,7 +163,7 @@ def _robot_from_spec(full: pin.Model, spec: dict, key: str) -> Robot:
     """The Robot of a schema-checked spec on the URDF's model `full`."""
     joints = tuple(spec["joints"])
     place_base(full, spec.get("base", {}))
-    model = _reduced_model(full, joints, spec.get("locked", {}))
+    model = reduced_model(full, joints, spec.get("locked", {}))
     n = len(joints)
     vec = functools.partial(_vector, spec, n=n)
     joint_of, offset, radius, link = _spheres(model, spec.get("spheres", []))
@@ -191,7 +191,7 @@ def place_base(model: pin.Model, base: dict) -> None:
             model.frames[k] = frame
 
 
-def _reduced_model(full: pin.Model, joints: tuple[str, ...], locked: dict[str, float]) -> pin.Model:
+def reduced_model(full: pin.Model, joints: tuple[str, ...], locked: dict[str, float]) -> pin.Model:
     """`full` with every joint but `joints` (URDF names, in tree order) locked at its `locked` value (default:
     its neutral position, 0)."""
     missing = [j for j in joints if not full.existJointName(j)]

@@ -1,0 +1,67 @@
+"""Self-collision sphere pairs of an imported robot: non-adjacent links, minus SRDF-disabled pairs, minus pairs
+already touching at the zero pose.
+
+Two spheres are a candidate pair when they move relative to each other and their links are not adjacent:
+their parent joints (of the planned model, locked joints merged into their parents) differ and neither is
+the other's parent. The SRDF's `<disable_collisions link1 link2>` drops link pairs; a pair whose spheres
+overlap at the zero pose (every planned joint at 0, clipped into its limits) drop their whole link pair (as
+MoveIt's setup assistant does with links in contact by default), and are reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ocpkit.robots.spheres import Sphere, urdf_root
+
+
+@dataclass(frozen=True)
+class Pairs:
+    """Kept pairs (P, 2) of sphere indices, and the link pairs dropped by the SRDF and for touching at q0."""
+
+    kept: list[tuple[int, int]]
+    disabled: set[frozenset[str]]
+    touching: set[frozenset[str]]
+
+
+def srdf_disabled(path: Path) -> set[frozenset[str]]:
+    """The link pairs of an SRDF's `<disable_collisions>` elements."""
+    return {frozenset((e.get("link1"), e.get("link2"))) for e in urdf_root(path).iter("disable_collisions")}
+
+
+def zero_pose(model: pin.Model) -> np.ndarray:
+    """Every joint at 0, clipped into the model's position limits (rad or m)."""
+    return np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit)
+
+
+def sphere_world(model: pin.Model, spheres: list[Sphere], q: np.ndarray) -> np.ndarray:
+    """World centres (M, 3) of `spheres` at configuration q (nq,)."""
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    return np.array([data.oMf[model.getFrameId(s.link)].act(np.asarray(s.center)) for s in spheres]).reshape(-1, 3)
+
+
+def self_collision_pairs(model: pin.Model, spheres: list[Sphere], disabled: set[frozenset[str]]) -> Pairs:
+    """The self-collision pairs of `spheres` on the planned `model` (module docstring)."""
+    joint = [model.frames[model.getFrameId(s.link)].parentJoint for s in spheres]
+    centres = sphere_world(model, spheres, zero_pose(model))
+    radius = np.array([s.radius for s in spheres])
+    candidates, dropped_srdf, touching = [], set(), set()
+    for a in range(len(spheres)):
+        for b in range(a + 1, len(spheres)):
+            ja, jb = joint[a], joint[b]
+            if ja == jb or model.parents[ja] == jb or model.parents[jb] == ja:
+                continue
+            links = frozenset((spheres[a].link, spheres[b].link))
+            if links in disabled:
+                dropped_srdf.add(links)
+                continue
+            candidates.append((a, b))
+            if np.linalg.norm(centres[a] - centres[b]) < radius[a] + radius[b]:
+                touching.add(links)
+    kept = [(a, b) for a, b in candidates if frozenset((spheres[a].link, spheres[b].link)) not in touching]
+    return Pairs(kept, dropped_srdf, touching)
