@@ -7,7 +7,9 @@ rule fills in, and `overrides` replace any value:
   87 N m, 11.5/s; industrial6: 15/s);
 - gear ratio = max(1, floor(MOTOR_SPEED / velocity limit)): the joint reaches its speed limit at the top speed
   of a 4000 rpm servo motor (the industrial6 rule); for a prismatic joint the velocity is in m/s;
-- friction zero.
+- friction zero;
+- a position limit within PI_ROUNDING of ±π or ±2π is read as exactly that (URDFs often write 3.14159 for π, and
+  the problems of benchmarks such as MotionBenchMaker then sit a few µrad outside it).
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ MOTOR_SPEED = 4000 * 2 * math.pi / 60
 """Assumed servo motor top speed, rad/s (4000 rpm), for the gear-ratio rule."""
 FRICTION_SMOOTHING = 0.05
 """rad/s (or m/s), as industrial6."""
+PI_ROUNDING = 1e-5
+"""rad: how close to ±π or ±2π a URDF position limit must be to be read as it."""
 OVERRIDABLE = ("lower", "upper", "velocity", "torque", "torque_rate", "gear_ratio", "viscous", "coulomb")
 """Fields `--set FIELD.JOINT=VALUE` may replace."""
 
@@ -111,6 +115,10 @@ def _joint_values(model: pin.Model, joints: list[str], overrides: dict[str, dict
     values = {"lower": model.lowerPositionLimit[index], "upper": model.upperPositionLimit[index],
               "velocity": model.velocityLimit[index], "torque": model.effortLimit[index]}
     values = {key: np.array(v, dtype=float) for key, v in values.items()}
+    for key in ("lower", "upper"):
+        for whole in (np.pi, 2 * np.pi):
+            near = np.abs(np.abs(values[key]) - whole) < PI_ROUNDING
+            values[key][near] = np.sign(values[key][near]) * whole
     for key, value in overrides.items():
         if key not in OVERRIDABLE:
             raise RobotError(f"--set {key}.…: unknown field; allowed: {', '.join(OVERRIDABLE)}")
@@ -133,7 +141,8 @@ def _joint_values(model: pin.Model, joints: list[str], overrides: dict[str, dict
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             raise RobotError(f"joint {joint}: position limits [{lo}, {hi}] are not a finite range; set them with "
                              f"--set lower.{joint}=VALUE --set upper.{joint}=VALUE")
-    return {key: [round(float(x), 6) for x in v] for key, v in values.items()}
+    return {key: [float(x) if key in ("lower", "upper") else round(float(x), 6) for x in v]
+            for key, v in values.items()}
 
 
 def _apply(values: np.ndarray, key: str, joints: list[str], overrides: dict[str, dict[str, float]]) -> None:

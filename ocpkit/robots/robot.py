@@ -202,8 +202,11 @@ def reduced_model(full: pin.Model, joints: tuple[str, ...], locked: dict[str, fl
         raise RobotError(f"'joints' must follow the URDF tree order {list(full.names[1:])}, each joint once")
     reference = pin.neutral(full)
     for name, value in locked.items():
-        if not full.existJointName(name) or name in joints:
-            raise RobotError(f"locked.{name}: not a URDF joint outside 'joints'")
+        if not full.existJointName(name):
+            raise RobotError(f"locked.{name}: not a movable joint of the URDF; its movable joints: "
+                             f"{list(full.names[1:])}")
+        if name in joints:
+            raise RobotError(f"locked.{name}: a planned joint (in 'joints') cannot be locked")
         joint = full.joints[full.getJointId(name)]
         if joint.nq != 1:
             raise RobotError(f"locked.{name}: only 1-DoF joints can be locked at a value (nq={joint.nq})")
