@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,7 +26,7 @@ import yaml
 
 from ocpkit.errors import RobotError
 from ocpkit.robots.robot import place_base, reduced_model
-from ocpkit.robots.self_collision import Pairs, self_collision_pairs, srdf_disabled
+from ocpkit.robots.self_collision import Pairs, self_collision_pairs
 from ocpkit.robots.spheres import Sphere, urdf_root
 from ocpkit.robots.urdf import EXAMPLE_ROBOT_DATA, example_robot_data_dir, model_from_urdf
 
@@ -88,7 +89,7 @@ def import_urdf(urdf: Path, spheres: list[Sphere], out_dir: Path, *, name: str |
                              "is not supported: lock it or leave it out)")
     model = planned_model(full, joints, locked, base)
     values = _joint_values(model, joints, overrides)
-    pairs = self_collision_pairs(model, spheres, srdf_disabled(srdf) if srdf else set())
+    pairs = self_collision_pairs(model, spheres, srdf)
     spec = {
         "name": name or _robot_name(urdf),
         "urdf": urdf_reference(Path(urdf), Path(out_dir)),
@@ -163,8 +164,9 @@ def write_spec(imported: Imported, out_dir: Path, header: str) -> Path:
 def pair_report(pairs: Pairs) -> str:
     """Lines naming the link pairs dropped from self-collision, and why."""
     def names(links: set[frozenset[str]]) -> str:
-        return ", ".join(sorted("/".join(sorted(p)) for p in links)) or "none"
+        text = ", ".join(sorted("/".join(sorted(p)) for p in links)) or "none"
+        return textwrap.fill(text, width=110, subsequent_indent="  ")
 
     return (f"self-collision: {len(pairs.kept)} sphere pairs kept\n"
             f"dropped, disabled in the SRDF: {names(pairs.disabled)}\n"
-            f"dropped, touching at the zero pose: {names(pairs.touching)}")
+            f"dropped, touching at {pairs.home}: {names(pairs.touching)}")

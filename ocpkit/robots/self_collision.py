@@ -4,8 +4,9 @@ already touching at the zero pose.
 Two spheres are a candidate pair when they move relative to each other and their links are not adjacent:
 their parent joints (of the planned model, locked joints merged into their parents) differ and neither is
 the other's parent. The SRDF's `<disable_collisions link1 link2>` drops link pairs; a pair whose spheres
-overlap at the zero pose (every planned joint at 0, clipped into its limits) drop their whole link pair (as
-MoveIt's setup assistant does with links in contact by default), and are reported.
+overlap at the home pose drop their whole link pair (as MoveIt's setup assistant does with links in contact by
+default), and are reported. The home pose is the SRDF's first `<group_state>` naming every planned joint (the
+Panda's 'ready'), else the zero pose (every planned joint at 0, clipped into its limits).
 """
 
 from __future__ import annotations
@@ -21,11 +22,12 @@ from ocpkit.robots.spheres import Sphere, urdf_root
 
 @dataclass(frozen=True)
 class Pairs:
-    """Kept pairs (P, 2) of sphere indices, and the link pairs dropped by the SRDF and for touching at q0."""
+    """Kept pairs (P, 2) of sphere indices, and the link pairs dropped by the SRDF and for touching at `home`."""
 
     kept: list[tuple[int, int]]
     disabled: set[frozenset[str]]
     touching: set[frozenset[str]]
+    home: str
 
 
 def srdf_disabled(path: Path) -> set[frozenset[str]]:
@@ -33,9 +35,14 @@ def srdf_disabled(path: Path) -> set[frozenset[str]]:
     return {frozenset((e.get("link1"), e.get("link2"))) for e in urdf_root(path).iter("disable_collisions")}
 
 
-def zero_pose(model: pin.Model) -> np.ndarray:
-    """Every joint at 0, clipped into the model's position limits (rad or m)."""
-    return np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit)
+def home_pose(model: pin.Model, srdf: Path | None) -> tuple[np.ndarray, str]:
+    """The home configuration (nq,) of the planned `model` (module docstring) and its name."""
+    names = list(model.names[1:])
+    for state in urdf_root(srdf).iter("group_state") if srdf else []:
+        values = {j.get("name"): float(j.get("value")) for j in state.iter("joint")}
+        if set(names) <= set(values):
+            return np.array([values[n] for n in names]), f"the SRDF's {state.get('name')!r} pose"
+    return np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit), "the zero pose"
 
 
 def sphere_world(model: pin.Model, spheres: list[Sphere], q: np.ndarray) -> np.ndarray:
@@ -45,10 +52,12 @@ def sphere_world(model: pin.Model, spheres: list[Sphere], q: np.ndarray) -> np.n
     return np.array([data.oMf[model.getFrameId(s.link)].act(np.asarray(s.center)) for s in spheres]).reshape(-1, 3)
 
 
-def self_collision_pairs(model: pin.Model, spheres: list[Sphere], disabled: set[frozenset[str]]) -> Pairs:
+def self_collision_pairs(model: pin.Model, spheres: list[Sphere], srdf: Path | None) -> Pairs:
     """The self-collision pairs of `spheres` on the planned `model` (module docstring)."""
     joint = [model.frames[model.getFrameId(s.link)].parentJoint for s in spheres]
-    centres = sphere_world(model, spheres, zero_pose(model))
+    disabled = srdf_disabled(srdf) if srdf else set()
+    q, home = home_pose(model, srdf)
+    centres = sphere_world(model, spheres, q)
     radius = np.array([s.radius for s in spheres])
     candidates, dropped_srdf, touching = [], set(), set()
     for a in range(len(spheres)):
@@ -64,4 +73,4 @@ def self_collision_pairs(model: pin.Model, spheres: list[Sphere], disabled: set[
             if np.linalg.norm(centres[a] - centres[b]) < radius[a] + radius[b]:
                 touching.add(links)
     kept = [(a, b) for a, b in candidates if frozenset((spheres[a].link, spheres[b].link)) not in touching]
-    return Pairs(kept, dropped_srdf, touching)
+    return Pairs(kept, dropped_srdf, touching, home)
