@@ -231,7 +231,7 @@ class Table(Node):
     value: Node
 
     def describe(self) -> str:
-        return f"a mapping of names to {self.value.describe()}s"
+        return f"a mapping of names to values, each {self.value.describe()}"
 
     def fits(self, value: Any) -> bool:
         return isinstance(value, dict)
