@@ -3,7 +3,8 @@
 Quality of spheres on a mesh (both measured on seeded samples, independent of the fit's own samples):
 - coverage: share of SURFACE_SAMPLES points drawn uniformly on the mesh surface that lie inside some sphere;
 - protrusion: how far the spheres reach beyond the mesh, m: the largest outside distance to the mesh surface
-  of POINTS_PER_SPHERE points spread evenly on each sphere (trimesh's signed distance).
+  of POINTS_PER_SPHERE points spread evenly on each sphere (trimesh's signed distance); sampled, so it
+  approaches the true value from below.
 
 The fit: for k = 1, 2, … up to the sphere budget, k-means (seeded) on points sampled inside the mesh gives k
 centres; each surface sample goes to its nearest centre and each radius is the farthest surface sample of its
