@@ -45,11 +45,17 @@ def home_pose(model: pin.Model, srdf: Path | None) -> tuple[np.ndarray, str]:
     return np.clip(np.zeros(model.nq), model.lowerPositionLimit, model.upperPositionLimit), "the zero pose"
 
 
-def sphere_world(model: pin.Model, spheres: list[Sphere], q: np.ndarray) -> np.ndarray:
-    """World centres (M, 3) of `spheres` at configuration q (nq,)."""
+def sphere_world(model: pin.Model, spheres: list[Sphere], qs: np.ndarray) -> np.ndarray:
+    """World centres of `spheres` at configurations qs (nq,) or (K, nq): shape (M, 3) or (K, M, 3)."""
     data = model.createData()
-    pin.framesForwardKinematics(model, data, q)
-    return np.array([data.oMf[model.getFrameId(s.link)].act(np.asarray(s.center)) for s in spheres]).reshape(-1, 3)
+    frames = [model.getFrameId(s.link) for s in spheres]
+    local = np.array([s.center for s in spheres], dtype=float).reshape(-1, 3)
+    out = []
+    for q in np.atleast_2d(qs):
+        pin.framesForwardKinematics(model, data, q)
+        poses = np.array([data.oMf[f].homogeneous for f in frames]).reshape(-1, 4, 4)
+        out.append(np.einsum("mij,mj->mi", poses[:, :3, :3], local) + poses[:, :3, 3])
+    return out[0] if np.ndim(qs) == 1 else np.array(out)
 
 
 def self_collision_pairs(model: pin.Model, spheres: list[Sphere], srdf: Path | None) -> Pairs:
@@ -74,3 +80,4 @@ def self_collision_pairs(model: pin.Model, spheres: list[Sphere], srdf: Path | N
                 touching.add(links)
     kept = [(a, b) for a, b in candidates if frozenset((spheres[a].link, spheres[b].link)) not in touching]
     return Pairs(kept, dropped_srdf, touching, home)
+
