@@ -103,7 +103,8 @@ def _import_command(args: argparse.Namespace) -> int:
                            overrides=_overrides(args.set))
     print(report)
     print(pair_report(imported.pairs))
-    header = (f"{imported.spec['name']}: imported by `ocpkit robot import` from {urdf.name} (spheres: {args.spheres}).\n"
+    header = (f"{imported.spec['name']}: imported by `ocpkit robot import` from {urdf.name} "
+              f"(spheres: {args.spheres}).\n"
               "Limits from the URDF; torque rate = 10/s x torque limit, gear ratio = floor(418.9 rad/s / velocity "
               "limit),\nfriction zero, unless overridden (ocpkit.robots.importer). Self-collision:\n"
               + pair_report(imported.pairs))
@@ -129,6 +130,9 @@ def _show_command(args: argparse.Namespace) -> int:
     from ocpkit.robots import builtin_robots, load_robot
     from ocpkit.robots.robot import robot_from_spec
 
+    if args.dir not in builtin_robots() and not (Path(args.dir) / "spec.yaml").is_file():
+        raise RobotError(f"{args.dir}: neither a built-in robot ({', '.join(builtin_robots())}) nor a folder with "
+                         "spec.yaml")
     robot = load_robot(args.dir) if args.dir in builtin_robots() else robot_from_spec(Path(args.dir) / "spec.yaml")
     out = Path(args.out)
     if not out.parent.is_dir():

@@ -43,7 +43,8 @@ def spec_urdf(spec: dict, spec_file: str) -> str:
     """The URDF file a spec names: relative to the spec, or example-robot-data:<path> in that package."""
     name = spec["urdf"]
     if name.startswith("example-robot-data:"):
-        share = importlib.metadata.distribution("example-robot-data").locate_file("cmeel.prefix/share/example-robot-data")
+        package = importlib.metadata.distribution("example-robot-data")
+        share = package.locate_file("cmeel.prefix/share/example-robot-data")
         return str(Path(share) / name.removeprefix("example-robot-data:"))
     return str(Path(spec_file).parent / name)
 

@@ -90,8 +90,9 @@ def load_robot(robot: str | dict[str, Any], base_dir: Path | None = None) -> Rob
 def robot_from_spec(spec_file: Path) -> Robot:
     """Build a Robot from a spec.yaml whose `urdf:` names its URDF (ocpkit.robots.urdf.resolve_urdf)."""
     spec_file = Path(spec_file)
+    text = _read(spec_file)
     with within(spec_file):
-        spec = read_yaml(_read(spec_file), RobotError)
+        spec = read_yaml(text, RobotError)
         check(spec, SPEC, RobotError)
         if "urdf" not in spec:
             raise RobotError("missing 'urdf' (the spec names no URDF; give the robot as {urdf: path, spec: path})")

@@ -28,10 +28,10 @@ SMALL_URDF = """<robot name="slide">
   <link name="slider"><collision><origin xyz="0.05 0 0"/><geometry><sphere radius="0.04"/></geometry></collision>
     <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <link name="tool"><collision><geometry><sphere radius="0.03"/></geometry></collision>
-    <inertial><mass value="0.5"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    <inertial><mass value="0.5"/><inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <link name="spare"><collision><origin xyz="0 0 0.2"/><geometry><sphere radius="0.05"/></geometry></collision>
     <collision><origin xyz="0.42 -0.3 0.3"/><geometry><sphere radius="0.03"/></geometry></collision>
-    <inertial><mass value="0.2"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    <inertial><mass value="0.2"/><inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <joint name="turn" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.3"/>
     <axis xyz="0 0 1"/><limit lower="-2" upper="2" velocity="1.5" effort="40"/></joint>
   <joint name="slide" type="prismatic"><parent link="arm"/><child link="slider"/><origin xyz="0.4 0 0"/>

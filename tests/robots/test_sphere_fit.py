@@ -68,8 +68,8 @@ def test_panda_links_from_example_robot_data_meshes_reach_99_percent():
 
 
 def test_spheres_command_prints_the_side_by_side_table(tmp_path, capsys):
-    (tmp_path / "b.urdf").write_text('<robot name="b"><link name="block"><collision><geometry><box size="0.4 0.1 0.06"/>'
-                                     '</geometry></collision></link></robot>')
+    (tmp_path / "b.urdf").write_text('<robot name="b"><link name="block"><collision><geometry>'
+                                     '<box size="0.4 0.1 0.06"/></geometry></collision></link></robot>')
     (tmp_path / "s.urdf").write_text('<robot name="b"><link name="block"><collision><geometry><sphere radius="0.25"/>'
                                      '</geometry></collision></link></robot>')
     assert main(["robot", "spheres", str(tmp_path / "b.urdf"), "--compare", str(tmp_path / "s.urdf")]) == 0
