@@ -88,3 +88,26 @@ def test_mbms_start_is_free_and_gravity_is_within_the_torque_limits():
     assert collision_report(robot, Scene(), READY) == []
     gravity = pin.computeGeneralizedGravity(robot.model, robot.model.createData(), READY)
     assert np.all(np.abs(gravity) < 0.8 * robot.tau_max)
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5"])
+def test_the_outside_checker_builds_the_same_model_from_the_spec(name):
+    """tests/outside_check.py reads urdf, base and locked on its own: same frames and torques as ocpkit."""
+    import yaml
+    from outside_check import robot_model, spec_urdf
+
+    from ocpkit.robots.robot import DATA_DIR
+
+    spec_file = DATA_DIR / name / "spec.yaml"
+    robot, model = load_robot(name), robot_model(yaml.safe_load(spec_file.read_text()), spec_urdf(
+        yaml.safe_load(spec_file.read_text()), str(spec_file)))
+    ours, theirs = robot.model.createData(), model.createData()
+    for _ in range(3):
+        q, qd = RNG.uniform(robot.q_lower, robot.q_upper), RNG.uniform(-1, 1, robot.n)
+        pin.framesForwardKinematics(robot.model, ours, q)
+        pin.framesForwardKinematics(model, theirs, q)
+        for frame in ("panda_hand", "panda_leftfinger") if name == "panda" else ("base_link", "tool0"):
+            np.testing.assert_allclose(theirs.oMf[model.getFrameId(frame)].homogeneous,
+                                       ours.oMf[robot.model.getFrameId(frame)].homogeneous, atol=1e-12)
+        np.testing.assert_allclose(pin.rnea(model, theirs, q, qd, qd), pin.rnea(robot.model, ours, q, qd, qd),
+                                   atol=1e-10)
