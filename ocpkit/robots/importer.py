@@ -153,11 +153,14 @@ def _apply(values: np.ndarray, key: str, joints: list[str], overrides: dict[str,
 
 def write_spec(imported: Imported, out_dir: Path, header: str) -> Path:
     """Write `imported.spec` to out_dir/spec.yaml under the comment `header`; the path written."""
-    out_dir.mkdir(parents=True, exist_ok=True)
     comment = "".join(f"# {line}\n".replace("# \n", "#\n") for line in header.splitlines())
     body = yaml.safe_dump(imported.spec, sort_keys=False, default_flow_style=None, width=120)
     path = out_dir / "spec.yaml"
-    path.write_text(comment + body)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        path.write_text(comment + body)
+    except OSError as exc:
+        raise RobotError(f"--out: cannot write {path}: {exc.strerror}") from None
     return path
 
 
