@@ -181,3 +181,12 @@ def test_import_copies_nothing_and_names_urdf_relative(small, tmp_path):
     shutil.copy(small / "slide.urdf", tmp_path / "slide2.urdf")
     assert main(["robot", "import", str(tmp_path / "slide2.urdf"), "--out", str(target), "--joints", "turn"]) == 0
     assert yaml.safe_load((target / "spec.yaml").read_text())["urdf"] == "../../slide2.urdf"
+
+
+def test_import_with_fitted_spheres_reports_each_link(small, capsys):
+    spec = run_import(small, "--joints", "turn,slide", "--spheres", "fit", "--budget", "3")
+    rows = {line.split()[0]: line.split("|")[1].split() for line in capsys.readouterr().out.splitlines()
+            if line.split() and line.split()[0] in ("base", "arm", "slider", "tool", "spare")}
+    assert set(rows) == {"base", "arm", "slider", "tool", "spare"}
+    assert all(1 <= int(count) <= 3 and float(cover) >= 99.0 for count, cover, _ in rows.values())
+    assert sum(int(count) for count, _, _ in rows.values()) == len(spec["spheres"])
