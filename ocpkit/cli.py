@@ -255,6 +255,8 @@ def parser() -> argparse.ArgumentParser:
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")
     ls.set_defaults(run=_list_command)
+    from ocpkit.robot_cli import add_robot_parser
+    add_robot_parser(commands)
     return main
 
 

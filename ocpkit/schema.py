@@ -224,6 +224,25 @@ class OneOf(Node):
         next(option for option in self.options if option.fits(value)).check(value, path)
 
 
+@dataclass(frozen=True)
+class Table(Node):
+    """A mapping from string keys (names chosen by the user, e.g. URDF joints) to `value` nodes."""
+
+    value: Node
+
+    def describe(self) -> str:
+        return f"a mapping of names to values, each {self.value.describe()}"
+
+    def fits(self, value: Any) -> bool:
+        return isinstance(value, dict)
+
+    def _check_inside(self, value: dict, path: str) -> None:
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise _Invalid(f"{_label(path)} keys must be names, got {show(key)}")
+            self.value.check(item, _child(path, key))
+
+
 def check(data: Any, node: Node, error: type[OcpkitError], path: str = "") -> None:
     """Raise `error` naming the offending field if `data` (parsed YAML) does not match `node`."""
     try:
@@ -257,8 +276,8 @@ def one_line(text: str) -> str:
     return text if len(text) <= 4 * SHOWN_CHARS else text[:4 * SHOWN_CHARS - 3] + "..."
 
 
-ROBOT = OneOf((String("a built-in robot name"), Mapping(required={"urdf": String(), "spec": String()})))
-"""`robot:` in a scenario: a built-in name or the files of a robot of one's own."""
+ROBOT = OneOf((String("a built-in robot name"), Mapping(required={"spec": String()}, optional={"urdf": String()})))
+"""`robot:` in a scenario: a built-in name, or the files of a robot of one's own (`urdf` may be left to the spec)."""
 
 OBSTACLE = Tagged({"sphere": Mapping(required={"center": vector(length=3), "radius": Number("positive")})})
 """One scene obstacle: `{sphere: {center: [x, y, z], radius: r}}` (metres, world frame)."""
@@ -289,6 +308,9 @@ SPEC = Mapping(
         "spheres": Sequence(Mapping(required={"link": String(), "center": vector(length=3),
                                               "radius": Number("positive")})),
         "self_collision": Sequence(Sequence(Number("non-negative", integer=True), length=2)),
+        "urdf": String("a URDF path (relative to the spec) or example-robot-data:<path>"),
+        "locked": Table(Number()),
+        "base": Mapping(optional={"xyz": vector(length=3), "rpy": vector(length=3)}),
     },
 )
 """A robot spec.yaml (README, 'Robot files'); every vector has one value per joint (checked on loading)."""

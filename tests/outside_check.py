@@ -2,6 +2,8 @@
 URDF and the scenario YAML (for the scene), and re-checks the samples with pinocchio.
 
 Usage: python tests/outside_check.py TRAJECTORY.json SPEC.yaml ROBOT.urdf SCENARIO.yaml
+(ROBOT.urdf `-`: the URDF the spec names in `urdf:`, relative to the spec or `example-robot-data:<path>`).
+The spec's `base` pose places the URDF root; joints not in `joints` are held at `locked` values (default 0).
 Prints one line per check and exits 1 if any fails: limits within 1 %, tau within 1 % of the torque range
 of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no sphere contact, and
 self-consistent samples: over each sample step the difference quotient of q (of qd) lies between qd (qdd) at
@@ -10,8 +12,10 @@ the step's ends (mean value theorem), within 1 % of the velocity limit (5 % of t
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import sys
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -35,9 +39,40 @@ def consistency(s: dict[str, np.ndarray], velocity_limit: np.ndarray) -> dict[st
             "qdd_consistency": np.max(outside_range(s["t"], s["qd"], s["qdd"]) / peak)}
 
 
+def spec_urdf(spec: dict, spec_file: str) -> str:
+    """The URDF file a spec names: relative to the spec, or example-robot-data:<path> in that package."""
+    name = spec["urdf"]
+    if name.startswith("example-robot-data:"):
+        package = importlib.metadata.distribution("example-robot-data")
+        share = package.locate_file("cmeel.prefix/share/example-robot-data")
+        return str(Path(share) / name.removeprefix("example-robot-data:"))
+    return str(Path(spec_file).parent / name)
+
+
+def robot_model(spec: dict, urdf: str) -> pin.Model:
+    """The planned model: the URDF with its root at the spec's `base` (xyz m, rpy rad) and every joint not in
+    `joints` locked at its `locked` value (default 0)."""
+    full = pin.buildModelFromUrdf(urdf)
+    base = spec.get("base", {})
+    pose = pin.SE3(pin.rpy.rpyToMatrix(*base.get("rpy", [0, 0, 0])), np.array(base.get("xyz", [0, 0, 0]), float))
+    for j in range(1, full.njoints):
+        if full.parents[j] == 0:
+            full.jointPlacements[j] = pose * full.jointPlacements[j]
+    for k in range(1, len(full.frames)):
+        frame = full.frames[k]
+        if frame.parentJoint == 0:
+            frame.placement = pose * frame.placement
+            full.frames[k] = frame
+    q = pin.neutral(full)
+    for name, value in spec.get("locked", {}).items():
+        q[full.joints[full.getJointId(name)].idx_q] = value
+    fixed = [j for j in range(1, full.njoints) if full.names[j] not in spec["joints"]]
+    return pin.buildReducedModel(full, fixed, q) if fixed else full
+
+
 def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, float]:
     """Worst value of every check: relative excess for limits, metres of penetration for geometry."""
-    model = pin.buildModelFromUrdf(urdf)
+    model = robot_model(spec, urdf)
     data = model.createData()
     s = {k: np.asarray(v, dtype=float) for k, v in trajectory["samples"].items()}
     lim, fr = spec["limits"], spec["friction"]
@@ -78,7 +113,8 @@ def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, 
 def main(argv: list[str]) -> int:
     trajectory_file, spec_file, urdf, scenario_file = argv
     with open(trajectory_file) as t, open(spec_file) as sp, open(scenario_file) as sc:
-        worst = check(json.load(t), yaml.safe_load(sp), urdf, yaml.safe_load(sc))
+        spec = yaml.safe_load(sp)
+        worst = check(json.load(t), spec, spec_urdf(spec, spec_file) if urdf == "-" else urdf, yaml.safe_load(sc))
     failed = False
     for name, value in worst.items():
         ok = value <= TOLERANCE.get(name, 0.01)

@@ -72,7 +72,7 @@ CASES = [
     ("name-list", "scenario", ("name",), ["case"], "name must be a string"),
     # issue items 8, 9: robot
     ("robot-name-is-a-path", "scenario", ("robot",), "../data/industrial6", "unknown robot '../data/industrial6'"),
-    ("robot-files-wrong-types", "scenario", ("robot",), {"urdf": 3, "spec": ["a"]}, "robot.urdf must be a string"),
+    ("robot-files-wrong-types", "scenario", ("robot",), {"urdf": 3, "spec": "s.yaml"}, "robot.urdf must be a string"),
     ("robot-without-spec", "scenario", ("robot",), {"urdf": "robot.urdf"}, "missing 'robot.spec'"),
     ("robot-number", "scenario", ("robot",), 6, "robot must be a built-in robot name or"),
     # time

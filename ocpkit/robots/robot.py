@@ -14,7 +14,7 @@ import pinocchio as pin
 
 from ocpkit.errors import RobotError, within
 from ocpkit.robots.friction import friction_slope, friction_torque
-from ocpkit.robots.urdf import model_from_urdf
+from ocpkit.robots.urdf import model_from_urdf, resolve_urdf
 from ocpkit.schema import ROBOT, SPEC, check, read_yaml, show
 
 DATA_DIR = Path(__file__).parent / "data"
@@ -24,7 +24,8 @@ DATA_DIR = Path(__file__).parent / "data"
 class Robot:
     """A serial robot with n joints and M collision spheres (SI units, radians).
 
-    `model` holds only the listed joints (others are locked at zero). Sphere j is rigidly attached to
+    `model` holds only the listed joints (the others are locked at the spec's `locked` values, default 0; the
+    URDF root sits at the spec's `base` pose). Sphere j is rigidly attached to
     pinocchio joint `sphere_joint[j]` (0 = universe) at `sphere_offset[j]` (metres, in that joint's frame).
     `key` identifies the content it was built from (sha256 hex of the URDF and spec files' bytes); Robots
     compare and hash by identity, and `robot_from_files` returns one object per key.
@@ -69,15 +70,33 @@ def builtin_robots() -> list[str]:
 
 
 def load_robot(robot: str | dict[str, Any], base_dir: Path | None = None) -> Robot:
-    """Load a built-in robot by name, or `{urdf: path, spec: path}` (relative paths start at base_dir)."""
+    """Load a built-in robot by name, `{urdf: path, spec: path}` or `{spec: path}` when the spec names its URDF
+    (relative paths start at base_dir)."""
     check(robot, ROBOT, RobotError, "robot")
     if isinstance(robot, dict):
         base = base_dir or Path.cwd()
-        return robot_from_files(base / robot["urdf"], base / robot["spec"])
+        if "urdf" in robot:
+            return robot_from_files(base / robot["urdf"], base / robot["spec"])
+        return robot_from_spec(base / robot["spec"])
     if robot not in builtin_robots():
         raise RobotError(f"unknown robot {show(robot)}; built-in robots: {', '.join(builtin_robots())}; "
-                         "a robot of your own is {urdf: path, spec: path}")
-    return robot_from_files(DATA_DIR / robot / "robot.urdf", DATA_DIR / robot / "spec.yaml")
+                         "a robot of your own is {urdf: path, spec: path} or {spec: path}")
+    folder = DATA_DIR / robot
+    if (folder / "robot.urdf").exists():
+        return robot_from_files(folder / "robot.urdf", folder / "spec.yaml")
+    return robot_from_spec(folder / "spec.yaml")
+
+
+def robot_from_spec(spec_file: Path) -> Robot:
+    """Build a Robot from a spec.yaml whose `urdf:` names its URDF (ocpkit.robots.urdf.resolve_urdf)."""
+    spec_file = Path(spec_file)
+    text = _read(spec_file)
+    with within(spec_file):
+        spec = read_yaml(text, RobotError)
+        check(spec, SPEC, RobotError)
+        if "urdf" not in spec:
+            raise RobotError("missing 'urdf' (the spec names no URDF; give the robot as {urdf: path, spec: path})")
+    return robot_from_files(resolve_urdf(spec["urdf"], spec_file.parent), spec_file)
 
 
 CACHE_SIZE = 16
@@ -144,7 +163,8 @@ def _vector(spec: dict, path: str, n: int) -> np.ndarray:
 def _robot_from_spec(full: pin.Model, spec: dict, key: str) -> Robot:
     """The Robot of a schema-checked spec on the URDF's model `full`."""
     joints = tuple(spec["joints"])
-    model = _reduced_model(full, joints)
+    place_base(full, spec.get("base", {}))
+    model = reduced_model(full, joints, spec.get("locked", {}))
     n = len(joints)
     vec = functools.partial(_vector, spec, n=n)
     joint_of, offset, radius, link = _spheres(model, spec.get("spheres", []))
@@ -160,16 +180,40 @@ def _robot_from_spec(full: pin.Model, spec: dict, key: str) -> Robot:
     return robot
 
 
-def _reduced_model(full: pin.Model, joints: tuple[str, ...]) -> pin.Model:
-    """`full` with every joint but `joints` (URDF names, in tree order) locked at its neutral position."""
+def place_base(model: pin.Model, base: dict) -> None:
+    """Move the URDF root of `model` (in place) to the schema-checked `base` pose: xyz (m), rpy (rad), default 0."""
+    pose = pin.SE3(pin.rpy.rpyToMatrix(*base.get("rpy", [0.0, 0.0, 0.0])), np.asarray(base.get("xyz", [0.0] * 3)))
+    for j in range(1, model.njoints):
+        if model.parents[j] == 0:
+            model.jointPlacements[j] = pose * model.jointPlacements[j]
+    for k, frame in enumerate(model.frames):
+        if frame.parentJoint == 0 and k > 0:
+            frame.placement = pose * frame.placement
+            model.frames[k] = frame
+
+
+def reduced_model(full: pin.Model, joints: tuple[str, ...], locked: dict[str, float]) -> pin.Model:
+    """`full` with every joint but `joints` (URDF names, in tree order) locked at its `locked` value (default:
+    its neutral position, 0)."""
     missing = [j for j in joints if not full.existJointName(j)]
     if missing:
         raise RobotError(f"joints not in the URDF: {missing}")
     keep = [full.getJointId(j) for j in joints]
     if any(a >= b for a, b in itertools.pairwise(keep)):
         raise RobotError(f"'joints' must follow the URDF tree order {list(full.names[1:])}, each joint once")
-    locked = [j for j in range(1, full.njoints) if j not in keep]
-    model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    reference = pin.neutral(full)
+    for name, value in locked.items():
+        if not full.existJointName(name):
+            raise RobotError(f"locked.{name}: not a movable joint of the URDF; its movable joints: "
+                             f"{list(full.names[1:])}")
+        if name in joints:
+            raise RobotError(f"locked.{name}: a planned joint (in 'joints') cannot be locked")
+        joint = full.joints[full.getJointId(name)]
+        if joint.nq != 1:
+            raise RobotError(f"locked.{name}: only 1-DoF joints can be locked at a value (nq={joint.nq})")
+        reference[joint.idx_q] = value
+    fixed = [j for j in range(1, full.njoints) if j not in keep]
+    model = pin.buildReducedModel(full, fixed, reference) if fixed else full
     if model.nq != len(joints) or model.nv != len(joints):
         raise RobotError(f"only 1-DoF joints are supported (nq={model.nq}, nv={model.nv})")
     return model

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.metadata
 import os
 import sys
 import tempfile
@@ -14,6 +15,26 @@ import pinocchio as pin
 
 from ocpkit.errors import RobotError
 from ocpkit.schema import one_line
+
+
+EXAMPLE_ROBOT_DATA = "example-robot-data:"
+"""Prefix of a spec's `urdf:` naming a file inside the example-robot-data package's share/example-robot-data/."""
+
+
+def example_robot_data_dir() -> Path:
+    """The share/example-robot-data folder of the installed example-robot-data package."""
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        raise RobotError("the example-robot-data package is not installed (pip install example-robot-data)") from None
+    return Path(dist.locate_file("cmeel.prefix/share/example-robot-data"))
+
+
+def resolve_urdf(reference: str, spec_dir: Path) -> Path:
+    """The file a spec's `urdf:` names: `example-robot-data:<path>` or a path relative to the spec's folder."""
+    if reference.startswith(EXAMPLE_ROBOT_DATA):
+        return example_robot_data_dir() / reference.removeprefix(EXAMPLE_ROBOT_DATA)
+    return spec_dir / reference
 
 
 def model_from_urdf(text: bytes, path: Path) -> pin.Model:

@@ -135,7 +135,8 @@ def test_broken_spec_is_explained(tmp_path, changes, message):
 
 @pytest.mark.parametrize("robot, message", [
     ({"urdf": "x"}, "missing 'robot.spec'"),
-    ({"urdf": 3, "spec": ["a"]}, "robot.urdf must be a string, got 3"),
+    ({"urdf": 3, "spec": "s.yaml"}, "robot.urdf must be a string, got 3"),
+    ({"spec": ["a"]}, "robot.spec must be a string"),
     (3, "robot must be a built-in robot name or a mapping with keys spec, urdf, got 3"),
     ("../data/industrial6", "unknown robot '../data/industrial6'"),  # a name, never a path
 ])
