@@ -100,6 +100,10 @@ def check_writable(path: Path, folder: bool = False) -> None:
 
 
 def _bench_command(args: argparse.Namespace) -> int:
+    if args.suite == "run":
+        from ocpkit.bench.run_command import run_command
+
+        return run_command(args, check_writable)
     out = Path(args.out or f"results/{args.suite}")
     check_writable(out, folder=True)
     if args.suite == "convergence":
@@ -187,6 +191,7 @@ def _names(registry) -> str:
 
 def parser() -> argparse.ArgumentParser:
     """The `ocpkit` argument parser; the component options list what the registries hold."""
+    from ocpkit.bench.run_command import add_run_arguments
     from ocpkit.dynamics import DYNAMICS
     from ocpkit.planner import GUESSES, PLANNERS
     from ocpkit.solvers import SOLVERS
@@ -220,10 +225,10 @@ def parser() -> argparse.ArgumentParser:
                    "when interrupted)")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite", epilog=exit_codes)
-    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random"],
+    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "run"],
                    help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
                    "solvers: every NLP solver x dynamics backend on the paper cases; random: seeded random "
-                   "industrial6 problems with obstacles in the way")
+                   "industrial6 problems with obstacles in the way; run: a suite file (scenarios x methods x repeats)")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml (default "
                    "scenarios/paper, relative to the current folder)")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
@@ -251,6 +256,7 @@ def parser() -> argparse.ArgumentParser:
                    help="random: obstacles per problem, drawn from MIN..MAX (default 1 1)")
     b.add_argument("--single-shot", action="store_true", help="random: plan without the fallback ladder (the "
                    "paper's one solve; bench paper always plans so)")
+    add_run_arguments(b)
     b.set_defaults(run=_bench_command)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")
