@@ -191,6 +191,7 @@ def _names(registry) -> str:
 
 def parser() -> argparse.ArgumentParser:
     """The `ocpkit` argument parser; the component options list what the registries hold."""
+    from ocpkit.bench.report_page import add_report_parser
     from ocpkit.bench.run_command import add_run_arguments
     from ocpkit.dynamics import DYNAMICS
     from ocpkit.planner import GUESSES, PLANNERS
@@ -258,6 +259,7 @@ def parser() -> argparse.ArgumentParser:
                    "paper's one solve; bench paper always plans so)")
     add_run_arguments(b)
     b.set_defaults(run=_bench_command)
+    add_report_parser(commands)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")
     ls.set_defaults(run=_list_command)

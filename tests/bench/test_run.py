@@ -78,7 +78,8 @@ def test_a_two_worker_dask_local_cluster_gives_the_rows_of_a_serial_run(serial, 
     assert comparable(read_rows(tmp_path / "out" / "results.csv")) == comparable(serial)
 
 
-def test_an_unreachable_scheduler_is_one_error_line(tmp_path, capsys):
+def test_an_unreachable_scheduler_is_one_error_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr("ocpkit.bench.run.CONNECT_TIMEOUT", "2s")
     assert main(["bench", "run", str(write_suite(tmp_path)), "--out", str(tmp_path / "out"),
                  "--scheduler", "tcp://127.0.0.1:1"]) == 2
     assert "--scheduler tcp://127.0.0.1:1: cannot connect" in capsys.readouterr().err
