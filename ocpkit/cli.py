@@ -197,6 +197,7 @@ def parser() -> argparse.ArgumentParser:
     from ocpkit.planner import GUESSES, PLANNERS
     from ocpkit.solvers import SOLVERS
     from ocpkit.transcription import TRANSCRIPTIONS
+    from ocpkit.viewer.command import add_show_parser
 
     exit_codes = __doc__.split("\n\n", 1)[1]
     main = argparse.ArgumentParser(prog="ocpkit", description=__doc__,
@@ -260,6 +261,7 @@ def parser() -> argparse.ArgumentParser:
     add_run_arguments(b)
     b.set_defaults(run=_bench_command)
     add_report_parser(commands)
+    add_show_parser(commands)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")
     ls.set_defaults(run=_list_command)
