@@ -10,7 +10,7 @@ import numpy as np
 import viser
 
 from ocpkit.scene import Workspace
-from ocpkit.viewer.motion import OBSTACLE_COLOR, ROBOT_COLOR, WORKSPACE_COLOR, Motion, Shape
+from ocpkit.viewer.motion import OBSTACLE_COLOR, ROBOT_COLOR, WORKSPACE_COLOR, Motion, Shape, box_edges
 
 DRAW = {
     "sphere": lambda server, name, p: server.scene.add_icosphere(name, radius=p["radius"], color=OBSTACLE_COLOR,
@@ -28,8 +28,11 @@ def serve(motion: Motion, shapes: list[Shape], workspace: Workspace | None, host
     for k, shape in enumerate(shapes):
         DRAW[shape.kind](server, f"/obstacles/{k}", shape.parameters)
     if workspace is not None:
-        server.scene.add_box("/workspace", color=WORKSPACE_COLOR, dimensions=tuple(workspace.upper - workspace.lower),
-                             wireframe=True, position=tuple((workspace.upper + workspace.lower) / 2))
+        server.scene.add_line_segments("/workspace", box_edges(workspace), WORKSPACE_COLOR, thickness=2.0,
+                                       thickness_units="screen")
+        middle = (workspace.upper + workspace.lower) / 2
+        server.initial_camera.look_at = tuple(middle)
+        server.initial_camera.position = tuple(middle + np.array([2.5, -3.5, 2.0]))
     spheres = [server.scene.add_icosphere(f"/robot/{j}", radius=float(r), color=ROBOT_COLOR,
                                           position=tuple(motion.centers[0, j])) for j, r in enumerate(motion.radii)]
     timeline = server.gui.add_slider("t [s]", min=0.0, max=float(motion.t[-1]), step=float(motion.t[1] - motion.t[0])

@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 from PIL import Image  # noqa: E402
 
 from ocpkit.scene import Workspace  # noqa: E402
-from ocpkit.viewer.motion import OBSTACLE_COLOR, ROBOT_COLOR, WORKSPACE_COLOR, Motion, Shape  # noqa: E402
+from ocpkit.viewer.motion import OBSTACLE_COLOR, ROBOT_COLOR, WORKSPACE_COLOR, Motion, Shape, box_edges  # noqa: E402
 
 MAX_FRAMES = 60
 """At most this many frames (evenly spread over the motion) go into a GIF."""
@@ -30,15 +30,6 @@ DRAW = {"sphere": lambda axes, p: _sphere(axes, np.asarray(p["center"]), p["radi
 """How each obstacle kind is drawn in matplotlib."""
 
 
-def _box_edges(axes, workspace: Workspace) -> None:
-    lo, hi = workspace.lower, workspace.upper
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    for a in range(8):
-        for b in range(a + 1, 8):
-            if np.count_nonzero(corners[a] != corners[b]) == 1:
-                axes.plot(*zip(corners[a], corners[b]), color=np.array(WORKSPACE_COLOR) / 255, lw=0.6)
-
-
 def write_gif(path: str | Path, motion: Motion, shapes: list[Shape], workspace: Workspace | None,
               size: tuple[int, int] = (480, 400)) -> int:
     """Write the motion as a GIF at `path` (frame delay = the motion's real time per frame); returns the number of
@@ -53,7 +44,8 @@ def write_gif(path: str | Path, motion: Motion, shapes: list[Shape], workspace: 
         for center, radius in zip(motion.centers[k], motion.radii):
             _sphere(axes, center, radius, ROBOT_COLOR, 1.0)
         if workspace is not None:
-            _box_edges(axes, workspace)
+            for start, end in box_edges(workspace):
+                axes.plot(*zip(start, end), color=np.array(WORKSPACE_COLOR) / 255, lw=0.6)
         points = motion.centers.reshape(-1, 3)
         lo, hi = (workspace.lower, workspace.upper) if workspace is not None else (points.min(0), points.max(0))
         axes.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), zlim=(lo[2], hi[2]), xlabel="x [m]", ylabel="y [m]",

@@ -15,7 +15,7 @@ import numpy as np
 from ocpkit.errors import OptionError
 from ocpkit.geometry import sphere_centers
 from ocpkit.problem import Problem
-from ocpkit.scene import Scene
+from ocpkit.scene import Scene, Workspace
 
 ROBOT_COLOR = (235, 110, 20)
 """RGB of the robot's spheres (orange: the viewer test looks for it)."""
@@ -70,3 +70,11 @@ def load_motion(path: str | Path, problem: Problem, fps: float = 30.0) -> Motion
     frames = np.append(np.arange(0.0, t[-1], 1.0 / fps), t[-1])
     q_frames = np.stack([np.interp(frames, t, q[:, j]) for j in range(robot.n)], axis=1)
     return Motion(frames, sphere_centers(robot, q_frames), robot.sphere_radius.copy())
+
+
+def box_edges(workspace: Workspace) -> np.ndarray:
+    """The 12 edges of the workspace box as segment end points, shape (12, 2, 3), m."""
+    lo, hi = workspace.lower, workspace.upper
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    return np.array([(corners[a], corners[b]) for a in range(8) for b in range(a + 1, 8)
+                     if np.count_nonzero(corners[a] != corners[b]) == 1])
