@@ -4,7 +4,8 @@
 Tables: the metrics (ocpkit.bench.metrics) per method and per method on each scene, success per method × scene.
 Figures: the success grid, the computation-time distribution per method, t_f against computation time, and for
 one plan (`plan`: a trajectory file; default the first verified row's) joint position, velocity, torque and
-torque rate against their limits. matplotlib with the headless Agg backend.
+torque rate against their limits. The figures show every plan that found a trajectory (the tables: verified
+ones only). matplotlib with the headless Agg backend.
 """
 
 from __future__ import annotations
@@ -50,8 +51,8 @@ def write_report(folder: Path, plan: Path | None = None) -> tuple[Path, Path]:
     tables = {"Per method": summarize(rows, ("method",)), "Per method and scene": summarize(rows, ("method", "scene"))}
     methods, scenes, rates = success_grid(rows)
     figures = {"Success per method and scene (%)": _success_figure(methods, scenes, rates),
-               "Computation time per method (verified plans)": _time_figure(rows, methods),
-               "Motion time against computation time": _tf_figure(rows, methods)}
+               "Computation time per method": _time_figure(rows, methods),
+               "Motion time against computation time (hollow: not verified)": _tf_figure(rows, methods)}
     if chosen is not None:
         figures[f"Plan {chosen.relative_to(folder) if chosen.is_relative_to(folder) else chosen}"] = \
             _plan_figure(folder, rows, chosen)
@@ -90,24 +91,29 @@ def _success_figure(methods: list, scenes: list, rates: np.ndarray) -> str:
     return _png(figure)
 
 
-def _verified(rows: list[dict], method: str) -> list[dict]:
-    return [r for r in rows if r["method"] == method and r["status"] == "verified"]
+def _found(rows: list[dict], method: str) -> list[dict]:
+    """The rows of `method` whose planner found a trajectory (verified or not)."""
+    return [r for r in rows if r["method"] == method and r["path_length_rad"] != ""]
 
 
 def _time_figure(rows: list[dict], methods: list) -> str:
     figure, axes = plt.subplots(figsize=(7, 0.8 + 0.5 * len(methods)))
-    data = [[float(r["solve_time_s"]) for r in _verified(rows, m)] or [np.nan] for m in methods]
+    data = [[float(r["solve_time_s"]) for r in _found(rows, m)] or [np.nan] for m in methods]
     axes.boxplot(data, orientation="horizontal", tick_labels=methods)
     axes.set_xscale("log")
-    axes.set_xlabel("computation time [s]")
+    axes.set_xlabel("computation time [s] of the plans that found a trajectory")
     return _png(figure)
 
 
 def _tf_figure(rows: list[dict], methods: list) -> str:
     figure, axes = plt.subplots(figsize=(7, 4.5))
-    for method in methods:
-        mine = _verified(rows, method)
-        axes.scatter([float(r["solve_time_s"]) for r in mine], [float(r["tf"]) for r in mine], label=method, s=18)
+    for method, color in zip(methods, plt.rcParams["axes.prop_cycle"].by_key()["color"] * len(methods)):
+        for ok, fill in ((True, color), (False, "none")):
+            mine = [r for r in _found(rows, method) if (r["status"] == "verified") == ok]
+            if not mine:
+                continue
+            axes.scatter([float(r["solve_time_s"]) for r in mine], [float(r["tf"]) for r in mine], s=22,
+                         facecolors=fill, edgecolors=color, label=f"{method} ({'verified' if ok else 'not verified'})")
     axes.set_xscale("log")
     axes.set_xlabel("computation time [s]")
     axes.set_ylabel("motion time $t_f$ [s]")
