@@ -1,4 +1,5 @@
-"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper|convergence|solvers|random`, `ocpkit list`.
+"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper|convergence|solvers|random|run`, `ocpkit report`,
+`ocpkit show`, `ocpkit list`.
 
 Exit codes: 0 planned and verified (bench, list: done); 1 planned but not verified (the status and the hint say
 why); 2 input error (one `error:` line); 130 interrupted by Ctrl-C (`interrupted`; no trajectory file is written,
