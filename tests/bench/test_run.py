@@ -152,3 +152,50 @@ def test_random_source_and_repeats_give_seeded_problems_and_seeds(tmp_path):
     assert [s.scene for s in suite.scenarios] == ["random-seed3"] * 2
     assert [suite.methods[0].plan_options(r)[1] for r in range(2)] == [5, 6]
     assert load_suite(tmp_path / "s.yaml").scenarios == suite.scenarios  # deterministic in the seed
+
+
+def test_the_shipped_suites_are_well_formed():
+    from ocpkit.bench.suite import SUITE
+    from ocpkit.schema import check, read_yaml
+
+    paper = load_suite(REPO / "suites/paper.yaml")
+    assert [s.case for s in paper.scenarios] == ["case1", "case2", "case3", "case4"]
+    assert [m.label for m in paper.methods] == ["simultaneous", "ompl-toppra"] and paper.repeats == 3
+    mbm = read_yaml((REPO / "suites/mbm-small.yaml").read_bytes(), SuiteError)
+    check(mbm, SUITE, SuiteError)  # the MBM subset and ompl-topp3 come with their own branches
+    assert [m["planner"] for m in mbm["methods"]] == ["simultaneous", "ompl-topp3", "ompl-toppra"]
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["bench", "run"], "bench run needs a suite file"),
+    (["bench", "run", "SUITE", "--jobs", "0"], "--jobs must be ≥ 1"),
+])
+def test_bad_run_options_are_one_error_line(tmp_path, capsys, arguments, message):
+    arguments = [str(write_suite(tmp_path)) if a == "SUITE" else a for a in arguments]
+    assert main([*arguments, "--out", str(tmp_path / "out")]) == 2
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_the_paper_suite_gives_the_same_rows_with_jobs_2_on_a_local_cluster_and_interrupted(tmp_path):
+    from dask.distributed import LocalCluster
+
+    suite = REPO / "suites/paper.yaml"
+    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "jobs"), "--jobs", "2"]) == 0
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        run_suite(suite, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False)
+    command = [sys.executable, "-m", "ocpkit.cli", "bench", "run", str(suite), "--out", str(tmp_path / "cut"),
+               "--jobs", "2"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    results = tmp_path / "cut" / "results.csv"
+    while process.poll() is None and not (results.exists() and len(read_rows(results)) >= 5):
+        time.sleep(0.05)
+    process.send_signal(signal.SIGINT)
+    process.communicate(timeout=60)
+    assert process.returncode == 130 and len(read_rows(results)) < 24
+    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "cut"), "--jobs", "2"]) == 0
+    jobs = comparable(read_rows(tmp_path / "jobs" / "results.csv"))
+    assert len(jobs) == 24
+    assert comparable(read_rows(tmp_path / "dask" / "results.csv")) == jobs
+    assert comparable(read_rows(results)) == jobs
+    assert main(["report", str(tmp_path / "cut")]) == 0
