@@ -7,6 +7,7 @@ Ctrl-C keeps the finished rows (the command exits 130); the progress bar shows t
 
 from __future__ import annotations
 
+import csv
 import multiprocessing
 import signal
 from collections.abc import Iterator
@@ -25,12 +26,14 @@ CONNECT_TIMEOUT = "20s"
 
 
 def run_suite(suite_file: str | Path, out: str | Path, jobs: int = 1, scheduler: str | None = None,
-              progress: bool = True) -> list[dict]:
+              progress: bool = True, repeats: int | None = None) -> list[dict]:
     """Run the suite into `out` with `jobs` local processes (1: in this process) or on the Dask scheduler at
-    address `scheduler` (e.g. tcp://host:8786); return every row of results.csv, earlier or new."""
+    address `scheduler` (e.g. tcp://host:8786), `repeats` times (default: the suite's); return every row of
+    results.csv, earlier or new. OptionError if out/results.csv holds another suite's or another command's rows."""
     suite, out = load_suite(suite_file), Path(out)
     tasks = [make_task(suite.name, s, m, r) for s in suite.scenarios for m in suite.methods
-             for r in range(suite.repeats)]
+             for r in range(repeats or suite.repeats)]
+    _check_earlier(out / "results.csv", suite.name)
     results = Results(out / "results.csv", RUN_COLUMNS, RUN_KEY_COLUMNS)
     if results.resumed:
         print(resumed_line(results), flush=True)
@@ -38,7 +41,7 @@ def run_suite(suite_file: str | Path, out: str | Path, jobs: int = 1, scheduler:
     pending = [t for t in tasks if task_key(t) not in results]
     where = f"Dask scheduler {scheduler}" if scheduler else f"{jobs} process{'es' if jobs > 1 else ''}"
     print(f"suite {suite.name}: {len(suite.scenarios)} scenarios x {len(suite.methods)} methods x "
-          f"{suite.repeats} repeats = {len(tasks)} rows, {len(pending)} to run on {where}", flush=True)
+          f"{repeats or suite.repeats} repeats = {len(tasks)} rows, {len(pending)} to run on {where}", flush=True)
     with reported_on_interrupt(results), tqdm(total=len(tasks), initial=len(tasks) - len(pending), unit="plan",
                                               disable=not progress, dynamic_ncols=True) as bar:
         for outcome in _outcomes(pending, jobs, scheduler):
@@ -51,6 +54,20 @@ def run_suite(suite_file: str | Path, out: str | Path, jobs: int = 1, scheduler:
     print(f"{verified} of {len(results.rows)} plans verified; results: {results.path.resolve()}; "
           f"report: ocpkit report {out}")
     return results.rows
+
+
+def _check_earlier(path: Path, suite: str) -> None:
+    """OptionError unless `path` is absent or a `bench run` results file of `suite` (resuming never drops rows)."""
+    if not path.exists():
+        return
+    with path.open(newline="") as handle:
+        reader = csv.DictReader(handle)
+        if tuple(reader.fieldnames or ()) != RUN_COLUMNS:
+            raise OptionError(f"{path} is not a results file of `ocpkit bench run` (other columns); choose another "
+                              "--out")
+        others = {row["suite"] for row in reader} - {suite}
+    if others:
+        raise OptionError(f"{path} holds rows of suite {sorted(others)[0]!r}, not {suite!r}; choose another --out")
 
 
 def _write_scenarios(out: Path, tasks: list[dict]) -> None:

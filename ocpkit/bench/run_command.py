@@ -13,7 +13,8 @@ def add_run_arguments(bench: argparse.ArgumentParser) -> None:
     """The options of `ocpkit bench run SUITE.yaml` on the `bench` parser."""
     bench.add_argument("suite_file", nargs="?", metavar="SUITE.yaml", help="run: the suite file (README, "
                        "'Benchmark suites')")
-    bench.add_argument("--jobs", type=int, default=1, help="run: local worker processes (default 1)")
+    bench.add_argument("--jobs", type=int, default=1, help="run: local worker processes (default 1); --repeats "
+                       "overrides the suite's repeats")
     bench.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run: run the tasks on this Dask "
                        "scheduler, e.g. tcp://host:8786, instead of local processes")
 
@@ -30,5 +31,5 @@ def run_command(args: argparse.Namespace, check_writable: Callable[..., None]) -
         raise OptionError(f"--jobs must be ≥ 1, got {args.jobs}")
     out = Path(args.out or f"results/{load_suite(args.suite_file).name}")
     check_writable(out, folder=True)
-    run_suite(args.suite_file, out, jobs=args.jobs, scheduler=args.scheduler)
+    run_suite(args.suite_file, out, jobs=args.jobs, scheduler=args.scheduler, repeats=args.repeats)
     return 0

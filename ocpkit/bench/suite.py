@@ -237,6 +237,9 @@ def _method(data: dict, where: str) -> Method:
                              f"{', '.join(taken)}")
     if planner == "simultaneous":
         _check_transcription(options, where)
+        if "seed" in options and options.get("guess") != "ompl":
+            raise SuiteError(f"{where}.seed: the simultaneous planner uses a seed only with guess: ompl (the OMPL "
+                             "guess's); its fallback ladder picks its own seeds")
     label = data.get("label") or " ".join([planner] + [f"{k}={v}" for k, v in options.items()])
     return Method(label, planner, options)
 

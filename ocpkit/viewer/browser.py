@@ -1,5 +1,5 @@
 """The interactive viewer: a viser server showing the robot's spheres, the obstacles and the workspace box, with
-a timeline slider and play/pause."""
+a timeline slider and Play / Pause buttons (playing loops from the start)."""
 
 from __future__ import annotations
 
@@ -37,7 +37,9 @@ def serve(motion: Motion, shapes: list[Shape], workspace: Workspace | None, host
                                           position=tuple(motion.centers[0, j])) for j, r in enumerate(motion.radii)]
     timeline = server.gui.add_slider("t [s]", min=0.0, max=float(motion.t[-1]), step=float(motion.t[1] - motion.t[0])
                                      if motion.frames > 1 else 0.01, initial_value=0.0)
-    playing = server.gui.add_checkbox("play", initial_value=False)
+    playing = threading.Event()
+    server.gui.add_button("Play", icon=viser.Icon.PLAYER_PLAY).on_click(lambda _: playing.set())
+    server.gui.add_button("Pause", icon=viser.Icon.PLAYER_PAUSE).on_click(lambda _: playing.clear())
 
     @timeline.on_update
     def _(_) -> None:
@@ -50,7 +52,7 @@ def serve(motion: Motion, shapes: list[Shape], workspace: Workspace | None, host
         period = motion.t[1] - motion.t[0] if motion.frames > 1 else 0.1
         while True:
             time.sleep(period)
-            if playing.value:
+            if playing.is_set():
                 timeline.value = 0.0 if timeline.value >= motion.t[-1] else min(timeline.value + period,
                                                                                 float(motion.t[-1]))
 

@@ -115,6 +115,8 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uni
     ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: ompl-toppra, knots: 8}]",
      "methods[0].knots: planner 'ompl-toppra' takes no option 'knots'"),
     ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, solver: nope}]", "methods[0].solver"),
+    ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, seed: 2}]",
+     "methods[0].seed: the simultaneous planner uses a seed only with guess: ompl"),
     ("scenarios: [{mbm: {robot: panda, scenes: [cage]}}]\nmethods: [{planner: simultaneous}]",
      "run `ocpkit data mbm`"),
     ("scenarios: [{random: {count: 2, obstacles: [3, 1]}}]\nmethods: [{planner: simultaneous}]",
@@ -164,6 +166,21 @@ def test_the_shipped_suites_are_well_formed():
     mbm = read_yaml((REPO / "suites/mbm-small.yaml").read_bytes(), SuiteError)
     check(mbm, SUITE, SuiteError)  # the MBM subset and ompl-topp3 come with their own branches
     assert [m["planner"] for m in mbm["methods"]] == ["simultaneous", "ompl-topp3", "ompl-toppra"]
+
+
+def test_an_out_folder_of_another_command_or_suite_is_refused_not_overwritten(tmp_path, capsys):
+    suite = write_suite(tmp_path)
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "results.csv").write_text("suite,case\npaper,case1\n")
+    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "out")]) == 2
+    assert "is not a results file of `ocpkit bench run`" in capsys.readouterr().err
+    assert (tmp_path / "out" / "results.csv").read_text() == "suite,case\npaper,case1\n"
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "suite.yaml").write_text(suite.read_text().replace("name: small", "name: other"))
+    run_suite(other / "suite.yaml", tmp_path / "out2", progress=False, repeats=1)
+    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "out2")]) == 2
+    assert "holds rows of suite 'other', not 'small'" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("arguments, message", [
