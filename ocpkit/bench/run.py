@@ -17,6 +17,7 @@ import yaml
 from tqdm import tqdm
 
 from ocpkit.bench.common import Results, reported_on_interrupt, resumed_line
+from ocpkit.bench.metrics import formatted, summarize
 from ocpkit.bench.suite import load_suite
 from ocpkit.bench.task import RUN_COLUMNS, RUN_KEY_COLUMNS, make_task, run_task, task_key
 from ocpkit.errors import OptionError
@@ -50,10 +51,20 @@ def run_suite(suite_file: str | Path, out: str | Path, jobs: int = 1, scheduler:
             path.write_text(outcome["trajectory"])
             results.add(outcome["row"])
             bar.update()
+    for line in summary_lines(results.rows):
+        print(line)
     verified = sum(r["status"] == "verified" for r in results.rows)
     print(f"{verified} of {len(results.rows)} plans verified; results: {results.path.resolve()}; "
           f"report: ocpkit report {out}")
     return results.rows
+
+
+def summary_lines(rows: list[dict]) -> list[str]:
+    """One line per method: runs, success and the verified plans' median and 98th-percentile computation time and
+    median t_f."""
+    return [f"{s['method']}: {s['runs']} runs, {formatted(s['success_%'])} % verified, computation median "
+            f"{formatted(s['time_median_s'])} s, p98 {formatted(s['time_p98_s'])} s, "
+            f"t_f median {formatted(s['tf_s'])} s" for s in summarize(rows, ("method",))]
 
 
 def _check_earlier(path: Path, suite: str) -> None:

@@ -235,6 +235,12 @@ def _method(data: dict, where: str) -> Method:
         if translated.get(key, key) not in taken:
             raise SuiteError(f"{where}.{key}: planner {planner!r} takes no option {key!r}; its options: "
                              f"{', '.join(taken)}")
+    if "planner_name" in options:
+        from ocpkit.baselines.ompl_toppra import OMPL_PLANNERS
+
+        if options["planner_name"] not in OMPL_PLANNERS:
+            raise SuiteError(f"{where}.planner_name: unknown OMPL planner {options['planner_name']!r}; known: "
+                             f"{', '.join(OMPL_PLANNERS)}")
     if planner == "simultaneous":
         _check_transcription(options, where)
         if "seed" in options and options.get("guess") != "ompl":

@@ -115,6 +115,8 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uni
     ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: ompl-toppra, knots: 8}]",
      "methods[0].knots: planner 'ompl-toppra' takes no option 'knots'"),
     ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, solver: nope}]", "methods[0].solver"),
+    ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: ompl-toppra, planner_name: rrt}]",
+     "methods[0].planner_name: unknown OMPL planner 'rrt'"),
     ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, seed: 2}]",
      "methods[0].seed: the simultaneous planner uses a seed only with guess: ompl"),
     ("scenarios: [{mbm: {robot: panda, scenes: [cage]}}]\nmethods: [{planner: simultaneous}]",
