@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ocpkit.bench.metrics import PLAN_METRICS, plan_metrics
 from ocpkit.bench.suite import Method, Scenario
+from ocpkit.ladder import DEFAULT_LADDER
 from ocpkit.planner import plan
 from ocpkit.report import RESULT_COLUMNS, result_row, trajectory_header
 from ocpkit.scenario import problem_from_dict
@@ -25,7 +26,8 @@ RUN_KEY_COLUMNS = ("suite", "scene", "case", "method", "repeat")
 RUN_COLUMNS = (*RESULT_COLUMNS, "robot", "scene", "method", "repeat", "guess", "seed", "wall_time_s",
                *PLAN_METRICS, "trajectory")
 """The columns of a `bench run` results.csv: those of ocpkit.report, the robot, scene, method label, repeat
-(0-based), initial guess and OMPL seed (empty where the method has none), the task's wall time (s, set-up
+(0-based), the initial guess and OMPL seed of the reported plan (the verified fallback rung's; empty where the
+plan used none), the task's wall time (s, set-up
 included) and the per-plan metrics (ocpkit.bench.metrics), and the trajectory file relative to the output."""
 
 
@@ -47,6 +49,18 @@ def trajectory_file(task: dict) -> str:
     return f"trajectories/{task['scene']}/{task['case']}--{slug}--r{task['repeat']}.json"
 
 
+def _guess_and_seed(planner: str, options: dict, seed: int | None, rung_name: str | None) -> tuple[str, int | None]:
+    """The initial guess and OMPL seed of the plan a row reports: for the simultaneous planner, those of the
+    fallback-ladder rung that gave it (ocpkit.ladder) where the rung overrides the method's; no guess otherwise."""
+    if planner != "simultaneous":
+        return "", seed
+    rung = next((r for r in options.get("fallbacks", DEFAULT_LADDER) if r.name == rung_name), None)
+    guess = (rung.guess if rung else None) or options.get("guess", "line")
+    if rung is not None and rung.guess is not None:
+        seed = rung.seed if guess == "ompl" else None
+    return guess, seed
+
+
 def run_task(task: dict) -> dict:
     """Plan the task; return {"row": the results row (RUN_COLUMNS), "trajectory": the trajectory JSON text}."""
     started = time.perf_counter()
@@ -58,9 +72,10 @@ def run_task(task: dict) -> dict:
     row = result_row(task["suite"], task["case"], result, result.stats.solve_time, result.stats.setup_time)
     metrics = plan_metrics(problem.robot, result.trajectory.sample()) if result.found else dict.fromkeys(
         PLAN_METRICS, "")
+    guess, seed = _guess_and_seed(method.planner, options, seed, result.method.get("rung"))
     row.update(robot=problem.robot.name, scene=task["scene"], method=method.label, repeat=task["repeat"],
-               guess=options.get("guess", "line") if method.planner == "simultaneous" else "",
-               seed="" if seed is None else seed, wall_time_s=wall, trajectory=trajectory_file(task), **metrics)
+               guess=guess, seed="" if seed is None else seed, wall_time_s=wall, trajectory=trajectory_file(task),
+               **metrics)
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "trajectory.json"
         write_json(path, result.trajectory, trajectory_header(problem, result),

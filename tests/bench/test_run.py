@@ -218,3 +218,12 @@ def test_the_paper_suite_gives_the_same_rows_with_jobs_2_on_a_local_cluster_and_
     assert comparable(read_rows(tmp_path / "dask" / "results.csv")) == jobs
     assert comparable(read_rows(results)) == jobs
     assert main(["report", str(tmp_path / "cut")]) == 0
+
+
+def test_the_guess_and_seed_columns_follow_the_fallback_rung_that_gave_the_plan():
+    from ocpkit.bench.task import _guess_and_seed
+
+    assert _guess_and_seed("simultaneous", {}, None, "first") == ("line", None)
+    assert _guess_and_seed("simultaneous", {}, None, "ompl-1") == ("ompl", 1)
+    assert _guess_and_seed("simultaneous", {"guess": "ompl", "fallbacks": ()}, 4, None) == ("ompl", 4)
+    assert _guess_and_seed("ompl-toppra", {"seed": 2}, 2, None) == ("", 2)
