@@ -77,3 +77,23 @@ def test_the_planner_arena_logs_load_into_sqlite_with_ompl_benchmark_statistics(
 def test_a_folder_without_results_is_one_error_line(tmp_path, capsys):
     assert main(["report", str(tmp_path)]) == 2
     assert "results.csv does not exist" in capsys.readouterr().err
+
+
+def test_the_run_writes_trajectories_and_scenarios_the_outside_checker_accepts(out):
+    import csv
+    import json
+
+    import yaml
+    from outside_check import TOLERANCE, check
+
+    from ocpkit.robots.robot import DATA_DIR
+
+    with (out / "results.csv").open(newline="") as handle:
+        verified = [r for r in csv.DictReader(handle) if r["status"] == "verified"]
+    assert len(verified) == 4
+    robot = DATA_DIR / "industrial6"
+    spec = yaml.safe_load((robot / "spec.yaml").read_text())
+    for row in verified:
+        scenario = yaml.safe_load((out / "scenarios" / row["scene"] / f"{row['case']}.yaml").read_text())
+        worst = check(json.loads((out / row["trajectory"]).read_text()), spec, str(robot / "robot.urdf"), scenario)
+        assert all(value <= TOLERANCE.get(name, 0.01) for name, value in worst.items()), (row["trajectory"], worst)
