@@ -192,7 +192,7 @@ def _names(registry) -> str:
 
 def parser() -> argparse.ArgumentParser:
     """The `ocpkit` argument parser; the component options list what the registries hold."""
-    from ocpkit.bench.report_page import add_report_parser
+    from ocpkit.bench.report_command import add_report_parser
     from ocpkit.bench.run_command import add_run_arguments
     from ocpkit.dynamics import DYNAMICS
     from ocpkit.planner import GUESSES, PLANNERS

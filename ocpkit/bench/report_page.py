@@ -188,19 +188,3 @@ def _markdown(suite: str, tables: dict, methods: list, scenes: list, rates: np.n
     return "\n".join(lines) + "\n"
 
 
-
-def add_report_parser(commands) -> None:
-    """`ocpkit report DIR [--plan TRAJ.json]` on the CLI's subcommands."""
-    r = commands.add_parser("report", help="HTML page and Markdown summary (and Planner Arena logs) of an "
-                            "`ocpkit bench run` output folder")
-    r.add_argument("folder", help="the --out folder of `ocpkit bench run`")
-    r.add_argument("--plan", default=None, help="trajectory file whose joint values to plot against the limits "
-                   "(relative to the folder; default the first verified plan)")
-    r.set_defaults(run=_report_command)
-
-
-def _report_command(args) -> int:
-    folder = Path(args.folder)
-    html_path, md_path = write_report(folder, Path(args.plan) if args.plan else None)
-    print(f"wrote {html_path.resolve()}, {md_path.resolve()} and {(folder / 'planner-arena').resolve()}/")
-    return 0
