@@ -97,3 +97,11 @@ def test_the_run_writes_trajectories_and_scenarios_the_outside_checker_accepts(o
         scenario = yaml.safe_load((out / "scenarios" / row["scene"] / f"{row['case']}.yaml").read_text())
         worst = check(json.loads((out / row["trajectory"]).read_text()), spec, str(robot / "robot.urdf"), scenario)
         assert all(value <= TOLERANCE.get(name, 0.01) for name, value in worst.items()), (row["trajectory"], worst)
+
+
+def test_plan_chooses_the_plotted_trajectory_and_a_missing_one_is_one_error_line(out, capsys):
+    baseline = "trajectories/paper/case3--baseline--r1.json"
+    assert main(["report", str(out), "--plan", baseline]) == 0
+    assert f"Plan {baseline}" in (out / "report.html").read_text()
+    assert main(["report", str(out), "--plan", "nope.json"]) == 2
+    assert "--plan nope.json: no such trajectory file" in capsys.readouterr().err
