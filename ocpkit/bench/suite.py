@@ -74,12 +74,11 @@ SUITE = Mapping(required={"scenarios": Sequence(SOURCE, min_length=1), "methods"
 @dataclass(frozen=True)
 class Scenario:
     """One problem of a suite as plain data: the parsed scenario mapping (robot files as absolute paths), its
-    case name and scene, and the seed of the random set it came from (None otherwise)."""
+    case name and scene (a random set's scene names its seed: random-seed1)."""
 
     case: str
     scene: str
     data: dict
-    seed: int | None = None
 
 
 @dataclass(frozen=True)
@@ -212,7 +211,7 @@ def _random(body: dict, base: Path, where: str) -> list[Scenario]:
     if low_high[0] > low_high[1]:
         raise SuiteError(f"{where}.obstacles needs [min, max] with min ≤ max, got {show(list(low_high))}")
     scene = f"random-seed{seed}"
-    return [Scenario(p.name, scene, scenario_data(p), seed) for p in random_problems(seed, body["count"], low_high)]
+    return [Scenario(p.name, scene, scenario_data(p)) for p in random_problems(seed, body["count"], low_high)]
 
 
 def _planner_parameters(planner: str) -> list[str]:
