@@ -1,4 +1,5 @@
-"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper|convergence|solvers|random`, `ocpkit list`.
+"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper|convergence|solvers|random|run`, `ocpkit report`,
+`ocpkit show`, `ocpkit list`.
 
 Exit codes: 0 planned and verified (bench, list: done); 1 planned but not verified (the status and the hint say
 why); 2 input error (one `error:` line); 130 interrupted by Ctrl-C (`interrupted`; no trajectory file is written,
@@ -100,6 +101,10 @@ def check_writable(path: Path, folder: bool = False) -> None:
 
 
 def _bench_command(args: argparse.Namespace) -> int:
+    if args.suite == "run":
+        from ocpkit.bench.run_command import run_command
+
+        return run_command(args, check_writable)
     out = Path(args.out or f"results/{args.suite}")
     check_writable(out, folder=True)
     if args.suite == "convergence":
@@ -187,10 +192,13 @@ def _names(registry) -> str:
 
 def parser() -> argparse.ArgumentParser:
     """The `ocpkit` argument parser; the component options list what the registries hold."""
+    from ocpkit.bench.report_command import add_report_parser
+    from ocpkit.bench.run_command import add_run_arguments
     from ocpkit.dynamics import DYNAMICS
     from ocpkit.planner import GUESSES, PLANNERS
     from ocpkit.solvers import SOLVERS
     from ocpkit.transcription import TRANSCRIPTIONS
+    from ocpkit.viewer.command import add_show_parser
 
     exit_codes = __doc__.split("\n\n", 1)[1]
     main = argparse.ArgumentParser(prog="ocpkit", description=__doc__,
@@ -220,10 +228,10 @@ def parser() -> argparse.ArgumentParser:
                    "when interrupted)")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite", epilog=exit_codes)
-    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random"],
+    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "run"],
                    help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
                    "solvers: every NLP solver x dynamics backend on the paper cases; random: seeded random "
-                   "industrial6 problems with obstacles in the way")
+                   "industrial6 problems with obstacles in the way; run: a suite file (scenarios x methods x repeats)")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml (default "
                    "scenarios/paper, relative to the current folder)")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
@@ -251,7 +259,10 @@ def parser() -> argparse.ArgumentParser:
                    help="random: obstacles per problem, drawn from MIN..MAX (default 1 1)")
     b.add_argument("--single-shot", action="store_true", help="random: plan without the fallback ladder (the "
                    "paper's one solve; bench paper always plans so)")
+    add_run_arguments(b)
     b.set_defaults(run=_bench_command)
+    add_report_parser(commands)
+    add_show_parser(commands)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")
     ls.set_defaults(run=_list_command)

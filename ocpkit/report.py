@@ -32,9 +32,9 @@ def result_row(suite: str, case: str, plan: Plan, solve_time: float, setup_time:
             "checks": plan.verification.summary(), "extra": json.dumps(plan.stats.extra)}
 
 
-def row_key(row: dict) -> tuple[str, ...]:
-    """The KEY_COLUMNS of `row` as strings (as read back from a CSV file)."""
-    return tuple(str(row.get(c, "")) for c in KEY_COLUMNS)
+def row_key(row: dict, columns: tuple[str, ...] = KEY_COLUMNS) -> tuple[str, ...]:
+    """The key `columns` (default KEY_COLUMNS) of `row` as strings (as read back from a CSV file)."""
+    return tuple(str(row.get(c, "")) for c in columns)
 
 
 @dataclass(frozen=True)

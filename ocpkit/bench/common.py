@@ -17,7 +17,7 @@ from ocpkit.errors import ScenarioError
 from ocpkit.plan import Plan
 from ocpkit.planner import plan
 from ocpkit.problem import Problem
-from ocpkit.report import RESULT_COLUMNS, row_key
+from ocpkit.report import KEY_COLUMNS, RESULT_COLUMNS, row_key
 from ocpkit.scenario import load_scenario
 
 
@@ -56,13 +56,14 @@ def write_csv(path: Path, rows: list[dict], columns: tuple[str, ...] = RESULT_CO
 class Results:
     """A results.csv that keeps every finished row: each row is appended as one complete, flushed and fsynced
     line when it is added. Rows already in the file (a complete row with this file's columns) are kept, and
-    `row` does not plan their key again: a re-run with the same file resumes."""
+    `row` does not plan their key again: a re-run with the same file resumes. A row's key is its `key_columns`."""
 
-    def __init__(self, path: Path, columns: tuple[str, ...] = RESULT_COLUMNS) -> None:
-        self.path, self.columns = Path(path), columns
+    def __init__(self, path: Path, columns: tuple[str, ...] = RESULT_COLUMNS,
+                 key_columns: tuple[str, ...] = KEY_COLUMNS) -> None:
+        self.path, self.columns, self.key_columns = Path(path), columns, key_columns
         self.rows = self._complete_rows()
         self.resumed = len(self.rows)
-        self._done = {row_key(r): r for r in self.rows}
+        self._done = {row_key(r, key_columns): r for r in self.rows}
         write_csv(self.path.with_name(self.path.name + ".tmp"), self.rows, columns)
         os.replace(self.path.with_name(self.path.name + ".tmp"), self.path)
 
@@ -88,7 +89,11 @@ class Results:
             handle.flush()
             os.fsync(handle.fileno())
         self.rows.append(row)
-        self._done[row_key(row)] = row
+        self._done[row_key(row, self.key_columns)] = row
+
+    def __contains__(self, key: tuple[str, ...]) -> bool:
+        """Whether a row with this key (row_key of key_columns) is in the file."""
+        return key in self._done
 
 
 @contextmanager

@@ -1,0 +1,90 @@
+"""The figures the motion-planning benchmarks report (robometrics, cuRobo), per plan and per group of rows.
+
+Per plan, from the dense samples: joint-space path length (rad, Σ‖Δq‖₂), end-effector path length (m, of the
+last joint's frame origin), peak torque and torque-rate use (max over time and joints of |τ|/τ_max and
+|τ̇|/τ̇_max; 1 is the limit). Per group (a method, or a method on a scene): runs, success (= verified) rate, and
+over the verified runs the computation time's mean, median, 75th and 98th percentile, motion time t_f, the path
+lengths and the peak uses (medians).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from ocpkit.robots import Robot
+from ocpkit.trajectory import Samples
+
+PLAN_METRICS = ("path_length_rad", "ee_path_length_m", "peak_torque_use", "peak_torque_rate_use")
+"""The per-plan columns of a `bench run` results.csv (empty when the planner found no trajectory)."""
+
+
+def end_effector_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """World position (m) of the last joint's frame origin at configurations q (K, n): shape (K, 3)."""
+    data = robot.model.createData()
+    out = np.empty((len(q), 3))
+    for k, qk in enumerate(q):
+        pin.forwardKinematics(robot.model, data, qk)
+        out[k] = data.oMi[robot.model.njoints - 1].translation
+    return out
+
+
+def plan_metrics(robot: Robot, samples: Samples) -> dict[str, float]:
+    """The PLAN_METRICS of a motion's dense `samples` on `robot` (module docstring)."""
+    steps = lambda x: np.linalg.norm(np.diff(x, axis=0), axis=1).sum()  # noqa: E731
+    return {"path_length_rad": float(steps(samples.q)),
+            "ee_path_length_m": float(steps(end_effector_positions(robot, samples.q))),
+            "peak_torque_use": float(np.max(np.abs(samples.tau) / robot.tau_max)),
+            "peak_torque_rate_use": float(np.max(np.abs(samples.taud) / robot.taud_max))}
+
+
+SUMMARY_COLUMNS = ("runs", "success_%", "time_mean_s", "time_median_s", "time_p75_s", "time_p98_s", "tf_s",
+                   "path_length_rad", "ee_path_length_m", "peak_torque_use", "peak_torque_rate_use")
+"""The columns of a summary row (after the group's names); times are over the verified runs, the rest medians."""
+
+
+def summarize(rows: list[dict], by: tuple[str, ...]) -> list[dict]:
+    """One summary row per distinct value of the `by` columns of results `rows` (in order of first appearance):
+    the group's names, then SUMMARY_COLUMNS (NaN where no run verified)."""
+    groups: dict[tuple, list[dict]] = {}
+    for row in rows:
+        groups.setdefault(tuple(row[c] for c in by), []).append(row)
+    return [{**dict(zip(by, names)), **_figures(group)} for names, group in groups.items()]
+
+
+def _figures(rows: list[dict]) -> dict:
+    verified = [r for r in rows if r["status"] == "verified"]
+    column = lambda name: np.array([float(r[name]) for r in verified])  # noqa: E731
+    stat = lambda f, name: float(f(column(name))) if verified else float("nan")  # noqa: E731
+    times = lambda q: (lambda x: np.percentile(x, q))  # noqa: E731
+    figures = {"runs": len(rows), "success_%": 100.0 * len(verified) / len(rows),
+               "time_mean_s": stat(np.mean, "solve_time_s"), "time_median_s": stat(np.median, "solve_time_s"),
+               "time_p75_s": stat(times(75), "solve_time_s"), "time_p98_s": stat(times(98), "solve_time_s"),
+               "tf_s": stat(np.median, "tf")}
+    figures.update({name: stat(np.median, name) for name in PLAN_METRICS})
+    return figures
+
+
+def success_grid(rows: list[dict], across: str = "scene", down: str = "method") -> tuple[list, list, np.ndarray]:
+    """Success rate (%) per `down` × `across` value: (down values, across values, rates (D, A), NaN where no
+    run)."""
+    downs, acrosses = _distinct(rows, down), _distinct(rows, across)
+    rates = np.full((len(downs), len(acrosses)), np.nan)
+    for i, d in enumerate(downs):
+        for j, a in enumerate(acrosses):
+            cell = [r["status"] == "verified" for r in rows if r[down] == d and r[across] == a]
+            if cell:
+                rates[i, j] = 100.0 * np.mean(cell)
+    return downs, acrosses, rates
+
+
+def _distinct(rows: list[dict], column: str) -> list:
+    return list(dict.fromkeys(r[column] for r in rows))
+
+
+def formatted(value: object, digits: int = 3) -> str:
+    """A table cell: floats to `digits` significant figures, NaN as '-'."""
+    if isinstance(value, float):
+        return "-" if np.isnan(value) else f"{value:.{digits}g}"
+    return str(value)
+

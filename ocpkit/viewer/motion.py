@@ -1,0 +1,80 @@
+"""What the viewers draw: the robot's spheres along a trajectory file, and the scenario's obstacles and workspace.
+
+Obstacles are listed by kind (`obstacle_shapes`); each viewer has one table from kind to drawing function, so a
+new obstacle kind is one entry here and one per viewer.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ocpkit.errors import OptionError
+from ocpkit.geometry import sphere_centers
+from ocpkit.problem import Problem
+from ocpkit.scene import Scene, Workspace
+
+ROBOT_COLOR = (235, 110, 20)
+"""RGB of the robot's spheres (orange: the viewer test looks for it)."""
+OBSTACLE_COLOR = (70, 110, 200)
+WORKSPACE_COLOR = (120, 120, 120)
+
+
+@dataclass(frozen=True)
+class Shape:
+    """One obstacle: its `kind` ('sphere') and the kind's parameters (metres, world frame)."""
+
+    kind: str
+    parameters: dict
+
+
+@dataclass(frozen=True)
+class Motion:
+    """The robot's spheres at frame times t (K,), s: centres (K, M, 3) and radii (M,), m."""
+
+    t: np.ndarray
+    centers: np.ndarray
+    radii: np.ndarray
+
+    @property
+    def frames(self) -> int:
+        return len(self.t)
+
+
+def obstacle_shapes(scene: Scene) -> list[Shape]:
+    """The scene's obstacles as Shapes (spheres: center (3,), radius)."""
+    return [Shape("sphere", {"center": c, "radius": float(r)})
+            for c, r in zip(scene.obstacle_centers, scene.obstacle_radii)]
+
+
+def load_motion(path: str | Path, problem: Problem, fps: float = 30.0) -> Motion:
+    """The motion of trajectory file `path` (its samples, else its knots) at `fps` frames per second on the
+    problem's robot; OptionError if the file is not a trajectory of that robot."""
+    path = Path(path)
+    try:
+        document = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise OptionError(f"cannot read trajectory {path}: {exc}") from None
+    robot = problem.robot
+    if not isinstance(document, dict) or "knots" not in document:
+        raise OptionError(f"{path} is not an ocpkit trajectory file (no 'knots')")
+    if document.get("robot") != robot.name or len(document.get("joint_names", ())) != robot.n:
+        raise OptionError(f"{path} is a trajectory of robot {document.get('robot')!r} with "
+                          f"{len(document.get('joint_names', ()))} joints, the scenario's robot is {robot.name!r} "
+                          f"with {robot.n}")
+    source = document.get("samples") or document["knots"]
+    t, q = np.asarray(source["t"], dtype=float), np.asarray(source["q"], dtype=float)
+    frames = np.append(np.arange(0.0, t[-1], 1.0 / fps), t[-1])
+    q_frames = np.stack([np.interp(frames, t, q[:, j]) for j in range(robot.n)], axis=1)
+    return Motion(frames, sphere_centers(robot, q_frames), robot.sphere_radius.copy())
+
+
+def box_edges(workspace: Workspace) -> np.ndarray:
+    """The 12 edges of the workspace box as segment end points, shape (12, 2, 3), m."""
+    lo, hi = workspace.lower, workspace.upper
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    return np.array([(corners[a], corners[b]) for a in range(8) for b in range(a + 1, 8)
+                     if np.count_nonzero(corners[a] != corners[b]) == 1])

@@ -1,0 +1,66 @@
+"""Per-plan metrics against closed forms, and the per-group summary against numpy on known rows."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from ocpkit.bench.metrics import end_effector_positions, plan_metrics, success_grid, summarize
+from ocpkit.robots import load_robot
+from ocpkit.trajectory import Samples
+
+
+def samples_of(q: np.ndarray, tau: np.ndarray, dt: float = 1e-3) -> Samples:
+    t = dt * np.arange(len(q))
+    zeros = np.zeros_like(q)
+    return Samples(t, q, zeros, zeros, tau, np.gradient(tau, t, axis=0))
+
+
+def test_a_base_rotation_gives_arc_lengths_and_the_limit_fractions():
+    robot = load_robot("industrial6")
+    start = np.array([0.0, 0.3, -0.2, 0.0, 0.4, 0.0])
+    angle = 1.2  # rad about the vertical base axis: the flange moves on a circle
+    q = start + np.outer(np.linspace(0, 1, 2001), [angle, 0, 0, 0, 0, 0])
+    tau = np.outer(np.sin(np.linspace(0, np.pi, 2001)), 0.5 * robot.tau_max)  # half the limit at the top
+    metrics = plan_metrics(robot, samples_of(q, tau))
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, start)
+    flange = data.oMi[robot.model.njoints - 1].translation
+    radius = np.hypot(flange[0], flange[1])  # joint 1 turns about the world z axis through the origin
+    assert metrics["path_length_rad"] == pytest.approx(angle, rel=1e-9)
+    assert metrics["ee_path_length_m"] == pytest.approx(radius * angle, rel=1e-5)
+    assert metrics["peak_torque_use"] == pytest.approx(0.5, rel=1e-6)
+    rate = 0.5 * robot.tau_max * np.pi / 2.0  # d/dt of 0.5 τmax sin(π t / 2 s) at t = 0
+    assert metrics["peak_torque_rate_use"] == pytest.approx(np.max(rate / robot.taud_max), rel=1e-3)
+
+
+def test_end_effector_positions_are_pinocchios_last_joint_origin():
+    robot = load_robot("industrial6")
+    q = np.random.default_rng(0).uniform(-1, 1, (3, robot.n))
+    data = robot.model.createData()
+    for k, position in enumerate(end_effector_positions(robot, q)):
+        pin.forwardKinematics(robot.model, data, q[k])
+        assert np.allclose(position, data.oMi[robot.model.njoints - 1].translation)
+
+
+def row(method: str, scene: str, status: str, time: float, tf: float = 1.0) -> dict:
+    metrics = {"path_length_rad": "1", "ee_path_length_m": "2", "peak_torque_use": "0.5", "peak_torque_rate_use": "0.9"}
+    return {"method": method, "scene": scene, "status": status, "solve_time_s": str(time), "tf": str(tf), **metrics}
+
+
+def test_summary_times_are_over_the_verified_runs_and_success_is_a_rate():
+    times = [0.1, 0.2, 0.4, 0.8, 3.0]
+    rows = [row("a", "s1", "verified", t) for t in times] + [row("a", "s2", "violated", 9.0),
+                                                            row("b", "s1", "no_path", 1.0)]
+    a, b = summarize(rows, ("method",))
+    assert a["runs"] == 6 and a["success_%"] == pytest.approx(500 / 6)
+    assert a["time_mean_s"] == pytest.approx(np.mean(times)) and a["time_median_s"] == 0.4
+    assert a["time_p75_s"] == pytest.approx(np.percentile(times, 75))
+    assert a["time_p98_s"] == pytest.approx(np.percentile(times, 98))
+    assert b["success_%"] == 0 and np.isnan(b["time_median_s"])
+    assert [(r["method"], r["scene"], r["runs"]) for r in summarize(rows, ("method", "scene"))] == [
+        ("a", "s1", 5), ("a", "s2", 1), ("b", "s1", 1)]
+    methods, scenes, rates = success_grid(rows)
+    assert methods == ["a", "b"] and scenes == ["s1", "s2"]
+    assert rates[0].tolist() == [100.0, 0.0] and rates[1, 0] == 0.0 and np.isnan(rates[1, 1])
