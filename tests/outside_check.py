@@ -3,7 +3,8 @@ URDF and the scenario YAML (for the scene), and re-checks the samples with pinoc
 
 Usage: python tests/outside_check.py TRAJECTORY.json SPEC.yaml ROBOT.urdf SCENARIO.yaml
 Prints one line per check and exits 1 if any fails: limits within 1 %, tau within 1 % of the torque range
-of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no sphere contact, and
+of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no contact of a robot sphere
+with an obstacle (sphere, box or cylinder; exact distances), with another sphere or the workspace faces, and
 self-consistent samples: over each sample step the difference quotient of q (of qd) lies between qd (qdd) at
 the step's ends (mean value theorem), within 1 % of the velocity limit (5 % of the peak acceleration).
 """
@@ -33,6 +34,28 @@ def consistency(s: dict[str, np.ndarray], velocity_limit: np.ndarray) -> dict[st
     peak = max(np.abs(s["qdd"]).max(), np.abs(np.diff(s["qd"], axis=0) / np.diff(s["t"])[:, None]).max(), 1e-300)
     return {"qd_consistency": np.max(outside_range(s["t"], s["q"], s["qd"]) / velocity_limit),
             "qdd_consistency": np.max(outside_range(s["t"], s["qd"], s["qdd"]) / peak)}
+
+
+def rotation(quaternion: list[float]) -> np.ndarray:
+    """Rotation matrix of [x, y, z, w] through pinocchio (normalised)."""
+    x, y, z, w = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
+    return pin.Quaternion(w, x, y, z).toRotationMatrix()
+
+
+def obstacle_distance(obstacle: dict, points: np.ndarray) -> np.ndarray:
+    """Exact signed distance (m) of points (..., 3) to a scenario obstacle {sphere|box|cylinder: {...}}."""
+    (kind, o), = obstacle.items()
+    offset = points - np.array(o["center"])
+    if kind == "sphere":
+        return np.linalg.norm(offset, axis=-1) - o["radius"]
+    local = offset @ rotation(o.get("orientation", [0, 0, 0, 1]))  # rows: Rᵀ (p - c)
+    if kind == "box":
+        excess = np.abs(local) - np.array(o["size"]) / 2
+    else:  # cylinder along local z
+        excess = np.stack([np.hypot(local[..., 0], local[..., 1]) - o["radius"],
+                           np.abs(local[..., 2]) - o["length"] / 2], axis=-1)
+    outside = np.sqrt(np.sum(np.clip(excess, 0, None) ** 2, axis=-1))
+    return np.where(excess.max(axis=-1) > 0, outside, excess.max(axis=-1))
 
 
 def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, float]:
@@ -65,8 +88,7 @@ def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, 
     worst["self_collision"] = max(0.0, -gaps.min())
     scene = scenario.get("scene", {})
     for obstacle in scene.get("obstacles", []):
-        o = obstacle["sphere"]
-        gap = np.linalg.norm(centres - np.array(o["center"]), axis=-1) - radii - o["radius"]
+        gap = obstacle_distance(obstacle, centres) - radii
         worst["obstacle"] = max(worst.get("obstacle", 0.0), -gap.min())
     if "workspace" in scene:
         box = scene["workspace"]
