@@ -1,4 +1,4 @@
-"""Exact signed distances (m) from points to oriented boxes and cylinders, and quaternions as rotations.
+"""Exact signed distances (m) from points to oriented boxes and cylinders.
 
 Negative inside (minus the depth to the nearest face). This is the numeric reference `geometry.clearances` (and so
 `verify`, validation and the OMPL validity checker) uses; the NLP uses a smooth form (constraints/collision.py).
@@ -9,14 +9,6 @@ from __future__ import annotations
 import numpy as np
 
 from ocpkit.scene import Boxes, Cylinders
-
-
-def quaternion_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrix (3, 3) of the unit quaternion q = [x, y, z, w] (ROS order); q is normalised first."""
-    x, y, z, w = np.asarray(q, dtype=float) / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
 def _local(points: np.ndarray, centers: np.ndarray, rotations: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ocpkit.distance import quaternion_matrix
+from ocpkit.quaternion import IDENTITY, quaternion_matrix
 from ocpkit.errors import ScenarioError, within
 from ocpkit.problem import Problem, TimeBounds
 from ocpkit.robots import load_robot
@@ -88,7 +88,7 @@ def _numbers(items: list[tuple[int, dict]], key: str) -> np.ndarray:
 
 def _rotations(items: list[tuple[int, dict]]) -> np.ndarray:
     """The (N, 3, 3) rotation matrices of each body's `orientation` quaternion [x, y, z, w] (identity if absent)."""
-    return np.asarray([quaternion_matrix(body.get("orientation", [0.0, 0.0, 0.0, 1.0])) for _, body in items],
+    return np.asarray([quaternion_matrix(body.get("orientation", IDENTITY)) for _, body in items],
                       dtype=float).reshape(-1, 3, 3)
 
 

@@ -1,5 +1,4 @@
-"""Exact signed distances to boxes and cylinders against coal (an independent collision library) and closed forms;
-quaternions against pinocchio."""
+"""Exact signed distances to boxes and cylinders against coal (an independent collision library) and closed forms."""
 
 from __future__ import annotations
 
@@ -8,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from ocpkit.distance import box_distance, cylinder_distance, quaternion_matrix
+from ocpkit.distance import box_distance, cylinder_distance
 from ocpkit.scene import Boxes, Cylinders
 
 RNG = np.random.default_rng(12)
@@ -19,14 +18,6 @@ def random_rotation(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     q = rng.normal(size=4)
     q /= np.linalg.norm(q)
     return q, pin.Quaternion(q[3], q[0], q[1], q[2]).toRotationMatrix()
-
-
-def test_quaternion_matrix_matches_pinocchio():
-    for _ in range(20):
-        q, expected = random_rotation(RNG)
-        np.testing.assert_allclose(quaternion_matrix(q), expected, atol=1e-12)
-    np.testing.assert_allclose(quaternion_matrix([0, 0, np.sin(np.pi / 4), np.cos(np.pi / 4)]) @ [1, 0, 0], [0, 1, 0],
-                               atol=1e-12)
 
 
 def coal_clearance(shape: coal.CollisionGeometry, rotation: np.ndarray, center: np.ndarray, point: np.ndarray,

@@ -12,7 +12,8 @@ from helpers import REPO
 import ocpkit
 from ocpkit.constraints import Context, PointValues
 from ocpkit.constraints.collision import MAX_MARGIN, SphereCollision, active_terms
-from ocpkit.distance import box_distance, cylinder_distance, quaternion_matrix
+from ocpkit.distance import box_distance, cylinder_distance
+from ocpkit.quaternion import quaternion_matrix
 from ocpkit.dynamics import make_dynamics
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.scene import Boxes, Cylinders, Scene, Workspace
