@@ -18,6 +18,7 @@ from ocpkit import interrupt
 from ocpkit.errors import OcpkitError, OptionError
 from ocpkit.plan import Plan
 from ocpkit.problem import Problem
+from ocpkit.scene_commands import add_scene_commands
 
 INTERRUPTED = 130
 WALL_TIME_OPTION = {"ompl-toppra": "planning_time"}
@@ -255,6 +256,7 @@ def parser() -> argparse.ArgumentParser:
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")
     ls.set_defaults(run=_list_command)
+    add_scene_commands(commands)
     return main
 
 
