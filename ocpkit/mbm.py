@@ -46,8 +46,9 @@ MBM_JOINTS = {
               "elbow_flex_joint", "forearm_roll_joint", "wrist_flex_joint", "wrist_roll_joint"],
 }
 """The planned joints of each MBM robot in MoveIt's group order, for when ocpkit has no such built-in robot."""
-NOTICE = (f"MotionBenchMaker problem converted by `ocpkit data mbm` from vamp-planner {VAMP_VERSION} "
-          "(resources/<robot>/problems.tar.bz2),", "Copyright the VAMP authors, Apache License 2.0 (LICENSE-vamp.txt).")
+NOTICE = ("MotionBenchMaker problem from vamp-planner {version} (resources/{robot}/problems.tar.bz2; Apache License "
+          "2.0, see LICENSE-vamp.txt),", "modified: converted from MoveIt YAML to an ocpkit scenario by `ocpkit data mbm`.")
+"""The licence notice at the top of every converted file (format with version and robot)."""
 
 
 class DataError(OcpkitError):
@@ -159,7 +160,8 @@ def convert_problems(robot: str, problems: Path, out: Path, progress: bool = Tru
                                      f"{scene}_{number}")
             target.parent.mkdir(parents=True, exist_ok=True)
             source = f"{robot}/moveit/problems/{scene}_{robot}/{{scene,request}}{number}.yaml"
-            target.write_text(scenario_text(conversion, [*NOTICE, f"Source: {source}"]))
+            notice = [line.format(version=VAMP_VERSION, robot=robot) for line in NOTICE]
+            target.write_text(scenario_text(conversion, [*notice, f"Source: {source}"]))
             written += 1
         if loaded is not None:
             try:

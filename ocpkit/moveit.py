@@ -33,7 +33,7 @@ PRIMITIVE_TYPES = {1: "box", 2: "sphere", 3: "cylinder", 4: "cone"}
 """shape_msgs/SolidPrimitive type numbers; YAML files also spell them as these names."""
 REMOVE = 1
 """moveit_msgs/CollisionObject operation REMOVE (ADD 0, APPEND 2, MOVE 3 are taken as they stand)."""
-SCENE_KEYS_READ = ("world", "robot_state", "name")
+SCENE_KEYS_READ = ("world", "robot_state")
 REQUEST_KEYS_READ = ("start_state", "goal_constraints")
 
 
@@ -51,12 +51,14 @@ def convert_moveit(scene: Any, request: Any, joints: Sequence[str], robot: str |
     robot's order); `robot` is the scenario's `robot:` entry. Raises MoveItError naming the field at fault."""
     scene, request = _mapping(scene, "the scene"), _mapping(request, "the request")
     ignored: list[str] = []
-    obstacles = _obstacles(_mapping(scene.get("world") or {}, "world"), ignored)
+    world = _mapping(scene.get("world") or {}, "world")
+    obstacles = _obstacles(world, ignored)
     start_positions = {**_joint_state(scene.get("robot_state"), "robot_state", ignored),
                        **_joint_state(request.get("start_state"), "start_state", ignored)}
     start = _planned(start_positions, joints, "start state (scene robot_state and request start_state)", ignored)
     goal = _planned(_joint_goal(request.get("goal_constraints"), ignored), joints, "goal_constraints", ignored)
-    for label, data, read in (("scene", scene, SCENE_KEYS_READ), ("request", request, REQUEST_KEYS_READ)):
+    for label, data, read in (("scene", scene, SCENE_KEYS_READ), ("world", world, ("collision_objects",)),
+                              ("request", request, REQUEST_KEYS_READ)):
         unused = sorted(str(key) for key in data if key not in read)
         if unused:
             ignored.append(f"{label}: {', '.join(unused)} not used")

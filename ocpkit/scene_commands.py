@@ -42,6 +42,7 @@ def _convert_moveit(args: argparse.Namespace) -> int:
     joints = [name.strip() for name in args.joints.split(",")] if args.joints else None
     if joints is not None and (not all(joints) or len(set(joints)) != len(joints)):
         raise MoveItError(f"--joints needs distinct non-empty names, got {args.joints!r}")
+    out.parent.mkdir(parents=True, exist_ok=True)  # relative robot paths are resolved through it
     field, joints, robot = resolve_robot(args.robot, out.parent, joints)
     conversion = read_moveit(args.scene, args.request, joints, field, args.name or out.stem)
     if robot is not None:
@@ -49,7 +50,6 @@ def _convert_moveit(args: argparse.Namespace) -> int:
             problem_from_dict(conversion.scenario, base_dir=out.parent)
         except OcpkitError as exc:
             raise MoveItError(f"the converted problem is not valid for ocpkit ({out} not written): {exc}") from exc
-    out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(scenario_text(conversion, [f"Converted by `ocpkit convert moveit` from {args.scene} and "
                                               f"{args.request}"]))
     for line in conversion.ignored:
