@@ -47,7 +47,8 @@ MBM_JOINTS = {
 }
 """The planned joints of each MBM robot in MoveIt's group order, for when ocpkit has no such built-in robot."""
 NOTICE = ("MotionBenchMaker problem from vamp-planner {version} (resources/{robot}/problems.tar.bz2; Apache License "
-          "2.0, see LICENSE-vamp.txt),", "modified: converted from MoveIt YAML to an ocpkit scenario by `ocpkit data mbm`.")
+          "2.0, see LICENSE-vamp.txt),",
+          "modified: converted from MoveIt YAML to an ocpkit scenario by `ocpkit data mbm`.")
 """The licence notice at the top of every converted file (format with version and robot)."""
 
 

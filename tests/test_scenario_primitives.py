@@ -13,7 +13,7 @@ from helpers import REPO
 from ocpkit.errors import ScenarioError
 from ocpkit.scenario import load_scenario, problem_from_dict
 
-BOXES = REPO / "scenarios/hard/boxes.yaml"
+BOXES = REPO / "scenarios/shapes/boxes.yaml"
 
 
 @pytest.fixture

@@ -150,9 +150,9 @@ def test_no_path_says_that_no_trajectory_was_found(case1):
 
 
 def test_ompl_avoids_boxes_and_cylinders():
-    """On scenarios/hard/boxes.yaml (the straight line hits the post) the validity checker agrees with the exact
+    """On scenarios/shapes/boxes.yaml (the straight line hits the post) the validity checker agrees with the exact
     distances and the path OMPL returns keeps clear of every box and cylinder at every dense sample."""
-    problem = ocpkit.load_scenario(REPO / "scenarios/hard/boxes.yaml")
+    problem = ocpkit.load_scenario(REPO / "scenarios/shapes/boxes.yaml")
     rng = np.random.default_rng(5)
     configurations = rng.uniform(problem.robot.q_lower, problem.robot.q_upper, (300, problem.robot.n))
     si = _space_information(problem, FreeSpace(problem, 0.0), resolution=0.01)

@@ -1,4 +1,4 @@
-"""End to end among boxes and cylinders: scenarios/hard/boxes.yaml plans to `verified` and its JSON passes the
+"""End to end among boxes and cylinders: scenarios/shapes/boxes.yaml plans to `verified` and its JSON passes the
 outside check, whose exact box and cylinder distances know nothing of ocpkit."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import ocpkit
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.report import trajectory_header
 
-BOXES = REPO / "scenarios/hard/boxes.yaml"
+BOXES = REPO / "scenarios/shapes/boxes.yaml"
 DATA = REPO / "ocpkit/robots/data/industrial6"
 pytestmark = pytest.mark.slow
 
