@@ -33,6 +33,7 @@ from tqdm import tqdm
 from ocpkit.errors import OcpkitError, RobotError
 from ocpkit.moveit import read_moveit, resolve_robot, scenario_text
 from ocpkit.scenario import load_scenario
+from ocpkit.schema import one_line
 
 VAMP_VERSION = "0.6.4"
 """The vamp-planner release whose problems.tar.bz2 files are read (pinned: the same problems on every machine)."""
@@ -119,7 +120,8 @@ def unpack_problems(sdist: Path, robot: str, directory: Path) -> Path:
             with tarfile.open(fileobj=outer.extractfile(members[inner]), mode="r:bz2") as problems:
                 _extract(problems, moveit)
     except (tarfile.TarError, OSError, EOFError) as exc:
-        raise DataError(f"cannot unpack {inner} from {sdist}: {exc} (delete the file to download it again)") from exc
+        raise DataError(f"cannot unpack {inner} from {sdist}: {one_line(str(exc))} (delete the file to download it "
+                        "again)") from exc
     done.touch()
     return moveit / "problems"
 
