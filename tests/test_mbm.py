@@ -77,7 +77,7 @@ def test_an_archive_member_outside_the_cache_is_refused(tmp_path):
 
 def test_a_broken_or_foreign_archive_and_an_unknown_robot_are_named(tmp_path, capsys):
     (tmp_path / f"vamp_planner-{VAMP_VERSION}.tar.gz").write_bytes(b"not a tar file")
-    with pytest.raises(DataError, match="cannot unpack resources/panda/problems.tar.bz2 .* delete the file"):
+    with pytest.raises(DataError, match="cannot unpack resources/panda/problems.tar.bz2 .*delete the file"):
         fetch_mbm("panda", tmp_path, progress=False)
     fake_sdist(tmp_path, one_problem())
     with pytest.raises(DataError, match="has no resources/ur5/problems.tar.bz2"):
