@@ -3,15 +3,14 @@ path, start and goal in contact name the obstacle."""
 
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 import pytest
 import yaml
 from helpers import REPO
+from test_scenario import load
 
 from ocpkit.errors import ScenarioError
-from ocpkit.scenario import load_scenario, problem_from_dict
+from ocpkit.scenario import load_scenario
 
 BOXES = REPO / "scenarios/shapes/boxes.yaml"
 
@@ -19,10 +18,6 @@ BOXES = REPO / "scenarios/shapes/boxes.yaml"
 @pytest.fixture
 def boxes() -> dict:
     return yaml.safe_load(BOXES.read_text())
-
-
-def load(data: dict):
-    return problem_from_dict(copy.deepcopy(data), base_dir=REPO)
 
 
 def test_boxes_and_cylinders_load_with_sizes_and_rotations():
