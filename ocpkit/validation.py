@@ -20,6 +20,7 @@ from ocpkit.scene import Scene
 from ocpkit.schema import COST, OBSTACLE, TIME, WORKSPACE, check, show
 
 LIMIT_SLACK = 1e-9  # rad: a start or goal exactly at a limit, given in degrees, must not fail on round-off
+SHOWN_CONTACTS = 3  # contacts named in a start/goal collision error; the rest are counted
 ROTATION_TOLERANCE = 1e-6  # an obstacle's rotation matrix must be orthonormal to this
 GRAVITY_SLACK = 1e-6  # relative: holding torque may exceed tau_max by round-off only
 
@@ -36,7 +37,9 @@ def validate(problem: Problem) -> None:
         _check_limits(robot, q, label)
         contacts = collision_report(robot, problem.scene, q)
         if contacts:
-            raise ScenarioError(f"{label} configuration is in collision: " + "; ".join(contacts))
+            more = f"; and {len(contacts) - SHOWN_CONTACTS} more" if len(contacts) > SHOWN_CONTACTS else ""
+            raise ScenarioError(f"{label} configuration is in collision: " + "; ".join(contacts[:SHOWN_CONTACTS])
+                                + more)
         _check_gravity(robot, q, label)
     lower_bound = problem.velocity_lower_bound()
     if problem.time.max < lower_bound:
