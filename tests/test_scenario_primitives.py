@@ -86,7 +86,7 @@ def test_a_problem_from_python_with_a_reflection_or_a_bad_size_is_rejected():
 
 
 def test_a_start_among_many_contacts_names_three_and_counts_the_rest(boxes):
-    boxes["scene"]["obstacles"].append({"box": {"center": [0.0, 0.0, 0.5], "size": [3.0, 3.0, 0.2]}})
+    boxes["scene"]["obstacles"].append({"box": {"center": [0.0, 0.0, 0.9], "size": [3.0, 3.0, 2.0]}})
     with pytest.raises(ScenarioError, match=r"start configuration is in collision: .*; and \d+ more$") as error:
         load(boxes)
     assert str(error.value).count("overlaps") == 3
