@@ -164,7 +164,9 @@ def convert_problems(robot: str, problems: Path, out: Path, progress: bool = Tru
             target.parent.mkdir(parents=True, exist_ok=True)
             source = f"{robot}/moveit/problems/{scene}_{robot}/{{scene,request}}{number}.yaml"
             notice = [line.format(version=VAMP_VERSION, robot=robot) for line in NOTICE]
-            target.write_text(scenario_text(conversion, [*notice, f"Source: {source}"]))
+            partial = target.with_suffix(".part")  # renamed when complete: an interrupted run leaves no half file
+            partial.write_text(scenario_text(conversion, [*notice, f"Source: {source}"]))
+            partial.replace(target)
             written += 1
         if loaded is not None:
             try:

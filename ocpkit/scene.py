@@ -69,8 +69,9 @@ class Scene:
         return len(self.obstacle_radii) + len(self.boxes) + len(self.cylinders)
 
     def obstacle_labels(self) -> list[str]:
-        """One label per obstacle, spheres then boxes then cylinders: `names` if given, else 'obstacle 3 (box)'."""
-        if self.names:
+        """One label per obstacle, spheres then boxes then cylinders: `names` if given (one per obstacle), else
+        'obstacle 3 (box)'."""
+        if len(self.names) == self.n_obstacles > 0:
             return list(self.names)
         counts = {"sphere": len(self.obstacle_radii), "box": len(self.boxes), "cylinder": len(self.cylinders)}
         kinds = [kind for kind, count in counts.items() for _ in range(count)]

@@ -111,7 +111,8 @@ def _check_primitives(scene: Scene) -> None:
                     or abs(np.linalg.det(rotation) - 1) > ROTATION_TOLERANCE):
                 raise ScenarioError(f"scene.{kind}.rotations[{k}] is not a rotation matrix: {show(rotation.tolist())}")
     if scene.names and len(scene.names) != scene.n_obstacles:
-        raise ScenarioError(f"scene.names needs one name per obstacle ({scene.n_obstacles}), got {len(scene.names)}")
+        raise ScenarioError(f"scene.names needs one name per obstacle ({scene.n_obstacles}), got {len(scene.names)} "
+                            "(replace the names with the obstacles, or set names=())")
 
 
 def _check_limits(robot: Robot, q: np.ndarray, label: str) -> None:

@@ -90,3 +90,14 @@ def test_a_start_among_many_contacts_names_three_and_counts_the_rest(boxes):
     with pytest.raises(ScenarioError, match=r"start configuration is in collision: .*; and \d+ more$") as error:
         load(boxes)
     assert str(error.value).count("overlaps") == 3
+
+
+def test_names_that_do_not_match_the_obstacles_are_rejected_not_misused(boxes):
+    import dataclasses
+
+    from ocpkit.validation import validate
+    problem = load(boxes)
+    fewer = dataclasses.replace(problem.scene, names=problem.scene.names[:2])
+    assert fewer.obstacle_labels()[0] == "obstacle 0 (box)"  # labels never come from a mismatched list
+    with pytest.raises(ScenarioError, match=r"scene.names needs one name per obstacle \(4\), got 2"):
+        validate(dataclasses.replace(problem, scene=fewer))
