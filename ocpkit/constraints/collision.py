@@ -88,26 +88,24 @@ class SphereCollision(Constraint):
                 "workspace": np.concatenate([np.zeros(0), *box])}
 
     def evaluate(self, point: PointValues, context: Context) -> Rows:
-        radius, margin = self.robot.sphere_radius, context.margin
+        radius, margin, p = self.robot.sphere_radius, context.margin, context.parameters
         centers = context.dynamics.sphere_centers(point.q)
-        obstacle_centers, obstacle_radii = context.parameters["obstacle_center"], context.parameters["obstacle_radius"]
         g = []
         for a, b in self.pairs:
             gap = centers[a, :] - centers[b, :]
             g.append(ca.dot(gap, gap) - (radius[a] + radius[b] + margin) ** 2)
         spheres, boxes, _ = self.counts
-        p = context.parameters
         for m, s in zip(*np.nonzero(self.obstacle_mask)):
             if s < spheres:
-                gap = centers[m, :] - obstacle_centers[s, :]
-                g.append(ca.dot(gap, gap) - (radius[m] + obstacle_radii[s] + margin) ** 2)
-                continue
-            kind, k = ("box", s - spheres) if s < spheres + boxes else ("cylinder", s - spheres - boxes)
-            local = _local(centers[m, :], p[f"{kind}_center"][k, :], p[f"{kind}_rotation"][k, :])
-            half = p[f"{kind}_half_size"][k, :]
-            g.append(_outside_squared(local, half, kind == "cylinder") - (radius[m] + margin) ** 2)
+                gap = centers[m, :] - p["obstacle_center"][s, :]
+                g.append(ca.dot(gap, gap) - (radius[m] + p["obstacle_radius"][s] + margin) ** 2)
+            else:
+                kind, k = ("box", s - spheres) if s < spheres + boxes else ("cylinder", s - spheres - boxes)
+                local = _local(centers[m, :], p[f"{kind}_center"][k, :], p[f"{kind}_rotation"][k, :])
+                outside = _outside_squared(local, p[f"{kind}_half_size"][k, :], kind == "cylinder")
+                g.append(outside - (radius[m] + margin) ** 2)
         upper = [np.inf] * len(g)
-        box = context.parameters["workspace"]
+        box = p["workspace"]
         for m, axis in zip(*np.nonzero(self.face_mask[:, :3] | self.face_mask[:, 3:])):
             g.append(_workspace_row(box, centers[m, axis], radius[m] + margin, axis, self.face_mask[m]))
             upper.append(1.0 if self.face_mask[m, axis] and self.face_mask[m, axis + 3] else np.inf)
