@@ -53,9 +53,10 @@ def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:
     a, b = robot.self_collision.T if len(robot.self_collision) else (np.zeros(0, int), np.zeros(0, int))
     self_pairs = np.linalg.norm(centers[:, a] - centers[:, b], axis=-1) - (r[a] + r[b])
     gaps = centers[:, :, None, :] - scene.obstacle_centers[None, None]
-    obstacles = np.concatenate([np.linalg.norm(gaps, axis=-1) - scene.obstacle_radii[None, :],
-                                box_distance(centers, scene.boxes), cylinder_distance(centers, scene.cylinders)],
-                               axis=-1) - r[:, None]
+    distances = [np.linalg.norm(gaps, axis=-1) - scene.obstacle_radii[None, :]]
+    shapes = ((box_distance, scene.boxes), (cylinder_distance, scene.cylinders))
+    distances += [distance(centers, group) for distance, group in shapes if len(group)]  # skipped when empty: the
+    obstacles = np.concatenate(distances, axis=-1) - r[:, None]  # OMPL validity checker calls this thousands of times
     if scene.workspace is None:
         workspace = np.zeros((len(centers), len(r), 0))
     else:
