@@ -78,9 +78,12 @@ def fetch_mbm(robot: str, directory: Path | None = None, progress: bool = True) 
     if robot not in ROBOTS:
         raise DataError(f"unknown MBM robot {robot!r}; choose one of {', '.join(ROBOTS)}")
     directory = Path(directory or default_directory()).expanduser()
-    sdist = download_vamp(directory)
-    problems = unpack_problems(sdist, robot, directory)
-    return convert_problems(robot, problems, directory / robot, progress)
+    try:
+        sdist = download_vamp(directory)
+        problems = unpack_problems(sdist, robot, directory)
+        return convert_problems(robot, problems, directory / robot, progress)
+    except OSError as exc:  # a folder that cannot be written, a full disk
+        raise DataError(f"cannot write the MBM cache: {exc.filename or directory}: {exc.strerror}") from exc
 
 
 def download_vamp(directory: Path) -> Path:

@@ -121,3 +121,9 @@ def test_real_download_from_a_clean_cache(tmp_path, capsys):
             assert len(list((tmp_path / robot / scene).glob("*.yaml"))) == 100
         shipped = yaml.safe_load((SHIPPED / robot / "cage/0003.yaml").read_text())
         assert yaml.safe_load((tmp_path / robot / "cage/0003.yaml").read_text()) == shipped
+
+
+def test_a_cache_folder_that_cannot_be_made_is_named(tmp_path):
+    (tmp_path / "file").write_text("")
+    with pytest.raises(DataError, match=r"cannot write the MBM cache: .*file/mbm"):
+        fetch_mbm("panda", tmp_path / "file" / "mbm", progress=False)
