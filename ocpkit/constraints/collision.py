@@ -7,8 +7,8 @@ the obstacle's frame, Σ_k max(|p_k| − h_k, 0)² ≥ (r + margin)² for a box 
 excess √(p_x² + p_y²) − R and the axial excess |p_z| − L/2). Its feasible set is exactly the true one (no rounding,
 no conservatism) and it is continuously differentiable with a Lipschitz gradient (|·| and the norm's kink lie where
 max(·, 0) is already 0); only its second derivative jumps across the planes of the faces, which IPOPT tolerates.
-What it costs: inside the obstacle the row is flat (zero gradient), so a guess through a box gives IPOPT no
-direction there (the ladder's OMPL guess is the remedy). Measured in README, 'Boxes and cylinders'.
+Its weakness: inside the obstacle the row is flat (zero gradient), so a guess deep inside a box gives IPOPT no
+direction there (the ladder's OMPL guess is the remedy). Rows and solve time: `ocpkit bench shapes` (README).
 
 Terms that can never be active are left out, which keeps the NLP (and IPOPT's KKT system) small: every
 robot sphere stays within its reach ρ of a fixed anchor (`ocpkit.robots.sphere_reach`), so a sphere whose
