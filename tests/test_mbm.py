@@ -8,9 +8,12 @@ import io
 import tarfile
 from pathlib import Path
 
+import numpy as np
+import pinocchio as pin
 import pytest
 import yaml
 from helpers import REPO
+from outside_check import obstacle_distance
 
 from ocpkit.cli import main
 from ocpkit.errors import OcpkitError
@@ -121,6 +124,33 @@ def test_real_download_from_a_clean_cache(tmp_path, capsys):
             assert len(list((tmp_path / robot / scene).glob("*.yaml"))) == 100
         shipped = yaml.safe_load((SHIPPED / robot / "cage/0003.yaml").read_text())
         assert yaml.safe_load((tmp_path / robot / "cage/0003.yaml").read_text()) == shipped
+        clearance = start_goal_clearance(tmp_path, robot)
+        assert len(clearance) == 1400 and (clearance < 0).sum() <= 2 and clearance.min() > -0.01
+
+
+def start_goal_clearance(cache: Path, robot: str) -> np.ndarray:
+    """Smallest clearance (m) of each converted start and goal against its scene, for vamp's own spherized model of
+    the robot (read from the cached sdist, joints set by name in pinocchio; distances of tests/outside_check.py).
+    MBM's starts and goals are valid, so a wrong pose composition or size convention would show as overlaps; the
+    spheres approximate the meshes MBM checked, so a few millimetres of overlap are allowed on a couple of them."""
+    with tarfile.open(cache / f"vamp_planner-{VAMP_VERSION}.tar.gz") as sdist:
+        name = f"vamp_planner-{VAMP_VERSION}/resources/{robot}/{robot}_spherized.urdf"
+        urdf = sdist.extractfile(name).read().decode()
+    model = pin.buildModelFromXML(urdf)
+    geometry = pin.buildGeomFromUrdfString(model, urdf, pin.COLLISION)
+    data, geometry_data = model.createData(), geometry.createData()
+    radii = np.array([g.geometry.radius for g in geometry.geometryObjects])
+    smallest = []
+    for file in sorted(cache.glob(f"{robot}/*/*.yaml")):
+        scenario = yaml.load(file.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+        for values in (scenario["start"], scenario["goal"]):
+            q = pin.neutral(model)
+            for joint, value in zip(MBM_JOINTS[robot], values):
+                q[model.joints[model.getJointId(joint)].idx_q] = value
+            pin.updateGeometryPlacements(model, data, geometry, geometry_data, q)
+            centers = np.array([placement.translation for placement in geometry_data.oMg])
+            smallest.append(min((obstacle_distance(o, centers) - radii).min() for o in scenario["scene"]["obstacles"]))
+    return np.array(smallest)
 
 
 def test_a_cache_folder_that_cannot_be_made_is_named(tmp_path):
