@@ -35,6 +35,8 @@ REMOVE = 1
 """moveit_msgs/CollisionObject operation REMOVE (ADD 0, APPEND 2, MOVE 3 are taken as they stand)."""
 SCENE_KEYS_READ = ("world", "robot_state")
 REQUEST_KEYS_READ = ("start_state", "goal_constraints")
+OBJECT_KEYS_READ = ("id", "header", "pose", "primitives", "primitive_poses", "operation", "meshes", "mesh_poses",
+                    "planes", "plane_poses")  # meshes and planes are counted as ignored
 
 
 @dataclass(frozen=True)
@@ -215,6 +217,9 @@ def _obstacles(world: dict, ignored: list[str]) -> list[dict]:
             count = len(_list(obj.get(key), f"{where}.{key}"))
             if count:
                 ignored.append(f"{label}: {count} {key}")
+        unused = sorted(str(key) for key in obj if key not in OBJECT_KEYS_READ)
+        if unused:
+            ignored.append(f"{label}: {', '.join(unused)} not used")
     return obstacles
 
 
