@@ -19,6 +19,7 @@ from ocpkit import interrupt
 from ocpkit.errors import OcpkitError, OptionError
 from ocpkit.plan import Plan
 from ocpkit.problem import Problem
+from ocpkit.scene_commands import add_scene_commands
 
 INTERRUPTED = 130
 WALL_TIME_OPTION = {"ompl-toppra": "planning_time"}
@@ -117,6 +118,10 @@ def _bench_command(args: argparse.Namespace) -> int:
 
         run_random(args.seed, args.count, _one_knot_count(args, "chebyshev"), obstacles=tuple(args.obstacles),
                    out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER)
+    elif args.suite == "shapes":
+        from ocpkit.bench.shapes import run_shapes_benchmark
+
+        run_shapes_benchmark(knots=_one_knot_count(args, "chebyshev"), repeats=args.repeats or 5)
     elif args.suite == "solvers":
         from ocpkit.bench.solvers import run_solver_benchmark
 
@@ -228,10 +233,12 @@ def parser() -> argparse.ArgumentParser:
                    "when interrupted)")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite", epilog=exit_codes)
-    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "run"],
+    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "shapes", "run"],
                    help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
                    "solvers: every NLP solver x dynamics backend on the paper cases; random: seeded random "
-                   "industrial6 problems with obstacles in the way; run: a suite file (scenarios x methods x repeats)")
+                   "industrial6 problems with obstacles in the way; shapes: what boxes and cylinders cost "
+                   "(scenarios/shapes/boxes.yaml with and without them); run: a suite file (scenarios x methods x "
+                   "repeats)")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml (default "
                    "scenarios/paper, relative to the current folder)")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
@@ -268,6 +275,7 @@ def parser() -> argparse.ArgumentParser:
     ls.set_defaults(run=_list_command)
     from ocpkit.robot_cli import add_robot_parser
     add_robot_parser(commands)
+    add_scene_commands(commands)
     return main
 
 

@@ -38,3 +38,7 @@ def within(where: object) -> Iterator[None]:
         yield
     except OcpkitError as exc:
         raise type(exc)(f"{where}: {exc}") from exc
+
+
+class MoveItError(OcpkitError):
+    """A MoveIt planning-scene or motion-plan-request file cannot be converted to a scenario."""

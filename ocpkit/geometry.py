@@ -1,7 +1,8 @@
 """Numeric sphere geometry with pinocchio: sphere centres and signed clearances (metres).
 
-A clearance is ≥ 0 when free: centre distance minus radii for sphere pairs, distance to the box face
-minus radius for the workspace. This module is the single numeric reference used by scenario checks,
+A clearance is ≥ 0 when free: centre distance minus radii for sphere pairs, the exact signed distance of the
+centre to an obstacle box or cylinder (`ocpkit.distance`) minus the radius, distance to the workspace face
+minus radius. This module is the single numeric reference used by scenario checks,
 `verify` and the baselines' validity checker.
 """
 
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from ocpkit.distance import box_distance, cylinder_distance
 from ocpkit.robots import Robot
 from ocpkit.scene import Scene
 
@@ -33,7 +35,8 @@ def sphere_centers(robot: Robot, q: np.ndarray, data: pin.Data | None = None) ->
 
 @dataclass(frozen=True)
 class Clearances:
-    """Signed clearances (m) for K configurations: self (K, P), obstacle (K, M, S), workspace (K, M, 6)."""
+    """Signed clearances (m) for K configurations: self (K, P), obstacle (K, M, S + B + C: spheres, boxes,
+    cylinders as in `Scene.obstacle_labels`), workspace (K, M, 6)."""
 
     self_pairs: np.ndarray
     obstacles: np.ndarray
@@ -50,7 +53,10 @@ def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:
     a, b = robot.self_collision.T if len(robot.self_collision) else (np.zeros(0, int), np.zeros(0, int))
     self_pairs = np.linalg.norm(centers[:, a] - centers[:, b], axis=-1) - (r[a] + r[b])
     gaps = centers[:, :, None, :] - scene.obstacle_centers[None, None]
-    obstacles = np.linalg.norm(gaps, axis=-1) - (r[:, None] + scene.obstacle_radii[None, :])
+    distances = [np.linalg.norm(gaps, axis=-1) - scene.obstacle_radii[None, :]]
+    shapes = ((box_distance, scene.boxes), (cylinder_distance, scene.cylinders))
+    distances += [distance(centers, group) for distance, group in shapes if len(group)]  # skipped when empty: the
+    obstacles = np.concatenate(distances, axis=-1) - r[:, None]  # OMPL validity checker calls this thousands of times
     if scene.workspace is None:
         workspace = np.zeros((len(centers), len(r), 0))
     else:
@@ -66,7 +72,8 @@ def collision_report(robot: Robot, scene: Scene, q: np.ndarray) -> list[str]:
     link = robot.sphere_link
     lines = [f"self-collision: sphere {i} ({link[i]}) and sphere {j} ({link[j]}) overlap by {-d:.3f} m"
              for (i, j), d in zip(robot.self_collision, c.self_pairs[0]) if d < 0]
-    lines += [f"sphere {m} ({link[m]}) overlaps obstacle {s} by {-c.obstacles[0, m, s]:.3f} m"
+    names = scene.obstacle_labels()
+    lines += [f"sphere {m} ({link[m]}) overlaps {names[s]} by {-c.obstacles[0, m, s]:.3f} m"
               for m, s in zip(*np.nonzero(c.obstacles[0] < 0))]
     faces = ["x min", "y min", "z min", "x max", "y max", "z max"]
     lines += [f"sphere {m} ({link[m]}) leaves the workspace at {faces[f]} by {-c.workspace[0, m, f]:.3f} m"

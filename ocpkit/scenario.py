@@ -12,10 +12,11 @@ from typing import Any
 
 import numpy as np
 
+from ocpkit.quaternion import IDENTITY, quaternion_matrix
 from ocpkit.errors import ScenarioError, within
 from ocpkit.problem import Problem, TimeBounds
 from ocpkit.robots import load_robot
-from ocpkit.scene import Scene, Workspace
+from ocpkit.scene import Boxes, Cylinders, Scene, Workspace
 from ocpkit.schema import SCENARIO, check, read_yaml, show
 from ocpkit.validation import validate
 
@@ -56,14 +57,39 @@ def _joint_values(values: list, where: str, n: int) -> np.ndarray:
 
 
 def _scene(data: dict) -> Scene:
-    """The Scene of a schema-checked `scene` mapping."""
-    spheres = [item["sphere"] for item in data.get("obstacles", [])]
-    centers = np.asarray([s["center"] for s in spheres], dtype=float).reshape(-1, 3)
-    radii = np.asarray([s["radius"] for s in spheres], dtype=float)
+    """The Scene of a schema-checked `scene` mapping; obstacles are named by their place in the file."""
+    listed = list(enumerate(data.get("obstacles", [])))
+    by_kind = {kind: [(k, item[kind]) for k, item in listed if kind in item] for kind in ("sphere", "box", "cylinder")}
+    spheres, boxes, cylinders = (by_kind[kind] for kind in ("sphere", "box", "cylinder"))
+    names = tuple(_obstacle_name(k, body, kind) for kind, items in by_kind.items() for k, body in items)
     box = data.get("workspace")
     workspace = None if box is None else Workspace(np.asarray(box["min"], dtype=float),
                                                    np.asarray(box["max"], dtype=float))
-    return Scene(centers, radii, workspace)
+    return Scene(_vectors(spheres, "center"), _numbers(spheres, "radius"), workspace,
+                 Boxes(_vectors(boxes, "center"), _vectors(boxes, "size"), _rotations(boxes)),
+                 Cylinders(_vectors(cylinders, "center"), _numbers(cylinders, "radius"), _numbers(cylinders, "length"),
+                           _rotations(cylinders)), names)
+
+
+def _obstacle_name(k: int, body: dict, kind: str) -> str:
+    """'obstacle 3 (box)', or 'obstacle 3 (box 'table')' when the file names it."""
+    return f"obstacle {k} ({kind} {body['name']!r})" if "name" in body else f"obstacle {k} ({kind})"
+
+
+def _vectors(items: list[tuple[int, dict]], key: str) -> np.ndarray:
+    """The (N, 3) array of field `key` of each obstacle body."""
+    return np.asarray([body[key] for _, body in items], dtype=float).reshape(-1, 3)
+
+
+def _numbers(items: list[tuple[int, dict]], key: str) -> np.ndarray:
+    """The (N,) array of field `key` of each obstacle body."""
+    return np.asarray([body[key] for _, body in items], dtype=float)
+
+
+def _rotations(items: list[tuple[int, dict]]) -> np.ndarray:
+    """The (N, 3, 3) rotation matrices of each body's `orientation` quaternion [x, y, z, w] (identity if absent)."""
+    return np.asarray([quaternion_matrix(body.get("orientation", IDENTITY)) for _, body in items],
+                      dtype=float).reshape(-1, 3, 3)
 
 
 def _time(data: dict) -> TimeBounds:

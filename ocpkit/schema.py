@@ -158,6 +158,22 @@ class Sequence(Node):
             self.element.check(item, f"{path}[{k}]")
 
 
+@dataclass(frozen=True)
+class Quaternion(Sequence):
+    """A rotation as a unit quaternion [x, y, z, w] (ROS order): four finite numbers of norm 1 within `tolerance`."""
+
+    element: Node = Number()
+    length: int | None = 4
+    tolerance: float = 1e-3
+
+    def _check_inside(self, value: Any, path: str) -> None:
+        super()._check_inside(value, path)
+        norm = math.sqrt(sum(float(v) ** 2 for v in value))
+        if abs(norm - 1.0) > self.tolerance:
+            raise _Invalid(f"{_label(path)} must be a unit quaternion [x, y, z, w] (norm 1 within {self.tolerance}), "
+                           f"got norm {norm:.6g}: {show(value)}")
+
+
 def vector(sign: Sign | None = None, length: int | None = None) -> Sequence:
     """A list of finite numbers (see Number for `sign`)."""
     return Sequence(Number(sign), length)
@@ -279,8 +295,18 @@ def one_line(text: str) -> str:
 ROBOT = OneOf((String("a built-in robot name"), Mapping(required={"spec": String()}, optional={"urdf": String()})))
 """`robot:` in a scenario: a built-in name, or the files of a robot of one's own (`urdf` may be left to the spec)."""
 
-OBSTACLE = Tagged({"sphere": Mapping(required={"center": vector(length=3), "radius": Number("positive")})})
-"""One scene obstacle: `{sphere: {center: [x, y, z], radius: r}}` (metres, world frame)."""
+OBSTACLE = Tagged({
+    "sphere": Mapping(required={"center": vector(length=3), "radius": Number("positive")},
+                      optional={"name": String()}),
+    "box": Mapping(required={"center": vector(length=3), "size": vector("positive", 3)},
+                   optional={"orientation": Quaternion(), "name": String()}),
+    "cylinder": Mapping(required={"center": vector(length=3), "radius": Number("positive"),
+                                  "length": Number("positive")},
+                        optional={"orientation": Quaternion(), "name": String()}),
+})
+"""One scene obstacle (metres, world frame; `orientation` a unit quaternion [x, y, z, w], default identity):
+`{sphere: {center, radius}}`, `{box: {center, size: full edge lengths [lx, ly, lz], orientation}}` or
+`{cylinder: {center, radius, length, orientation}}` (axis along local z); each may carry a `name` for messages."""
 WORKSPACE = Mapping(required={"min": vector(length=3), "max": vector(length=3)})
 TIME = Mapping(optional={key: Number("positive") for key in ("min", "max", "guess")})
 COST = Mapping(optional={"mu": Number("non-negative")})

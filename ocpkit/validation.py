@@ -20,6 +20,8 @@ from ocpkit.scene import Scene
 from ocpkit.schema import COST, OBSTACLE, TIME, WORKSPACE, check, show
 
 LIMIT_SLACK = 1e-9  # rad: a start or goal exactly at a limit, given in degrees, must not fail on round-off
+SHOWN_CONTACTS = 3  # contacts named in a start/goal collision error; the rest are counted
+ROTATION_TOLERANCE = 1e-6  # an obstacle's rotation matrix must be orthonormal to this
 GRAVITY_SLACK = 1e-6  # relative: holding torque may exceed tau_max by round-off only
 
 
@@ -35,7 +37,9 @@ def validate(problem: Problem) -> None:
         _check_limits(robot, q, label)
         contacts = collision_report(robot, problem.scene, q)
         if contacts:
-            raise ScenarioError(f"{label} configuration is in collision: " + "; ".join(contacts))
+            more = f"; and {len(contacts) - SHOWN_CONTACTS} more" if len(contacts) > SHOWN_CONTACTS else ""
+            raise ScenarioError(f"{label} configuration is in collision: " + "; ".join(contacts[:SHOWN_CONTACTS])
+                                + more)
         _check_gravity(robot, q, label)
     lower_bound = problem.velocity_lower_bound()
     if problem.time.max < lower_bound:
@@ -76,12 +80,39 @@ def _check_scene(scene: Scene) -> None:
                             f"{radii.shape}")
     for k, (center, radius) in enumerate(zip(centers.tolist(), radii.tolist())):
         check({"sphere": {"center": center, "radius": radius}}, OBSTACLE, ScenarioError, f"scene.obstacles[{k}]")
+    _check_primitives(scene)
     if scene.workspace is not None:
         lower = _float_array(scene.workspace.lower, "scene.workspace.min")
         upper = _float_array(scene.workspace.upper, "scene.workspace.max")
         check({"min": lower.tolist(), "max": upper.tolist()}, WORKSPACE, ScenarioError, "scene.workspace")
         if np.any(lower >= upper):
             raise ScenarioError(f"scene.workspace: min {lower} must be below max {upper}")
+
+
+def _check_primitives(scene: Scene) -> None:
+    """Boxes and cylinders: centres (N, 3) finite, sizes, radii and lengths finite and > 0 (m), rotations (N, 3, 3)
+    proper (orthonormal, det +1, within ROTATION_TOLERANCE); `names` one per obstacle if given."""
+    parts = {"boxes": {"centers": 3, "sizes": 3}, "cylinders": {"centers": 3, "radii": 0, "lengths": 0}}
+    for kind, fields in parts.items():
+        group = getattr(scene, kind)
+        count = len(_float_array(group.centers, f"scene.{kind}.centers"))
+        for name, width in fields.items():
+            values = _float_array(getattr(group, name), f"scene.{kind}.{name}")
+            if values.shape != ((count, width) if width else (count,)) or not np.all(np.isfinite(values)):
+                raise ScenarioError(f"scene.{kind}.{name} needs {count} finite values of width {width or 1}, got "
+                                    f"shape {values.shape}: {show(values.tolist())}")
+            if name != "centers" and np.any(values <= 0):
+                raise ScenarioError(f"scene.{kind}.{name} must be > 0, got {show(values.tolist())}")
+        rotations = _float_array(group.rotations, f"scene.{kind}.rotations")
+        if rotations.shape != (count, 3, 3) or not np.all(np.isfinite(rotations)):
+            raise ScenarioError(f"scene.{kind}.rotations needs shape ({count}, 3, 3), got {rotations.shape}")
+        for k, rotation in enumerate(rotations):
+            if (np.abs(rotation.T @ rotation - np.eye(3)).max() > ROTATION_TOLERANCE
+                    or abs(np.linalg.det(rotation) - 1) > ROTATION_TOLERANCE):
+                raise ScenarioError(f"scene.{kind}.rotations[{k}] is not a rotation matrix: {show(rotation.tolist())}")
+    if scene.names and len(scene.names) != scene.n_obstacles:
+        raise ScenarioError(f"scene.names needs one name per obstacle ({scene.n_obstacles}), got {len(scene.names)} "
+                            "(replace the names with the obstacles, or set names=())")
 
 
 def _check_limits(robot: Robot, q: np.ndarray, label: str) -> None:

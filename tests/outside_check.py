@@ -5,7 +5,8 @@ Usage: python tests/outside_check.py TRAJECTORY.json SPEC.yaml ROBOT.urdf SCENAR
 (ROBOT.urdf `-`: the URDF the spec names in `urdf:`, relative to the spec or `example-robot-data:<path>`).
 The spec's `base` pose places the URDF root; joints not in `joints` are held at `locked` values (default 0).
 Prints one line per check and exits 1 if any fails: limits within 1 %, tau within 1 % of the torque range
-of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no sphere contact, and
+of rnea(q, qd, qdd) + friction, torque rate (finite differences of tau) within 1 %, no contact of a robot sphere
+with an obstacle (sphere, box or cylinder; exact distances), with another sphere or the workspace faces, and
 self-consistent samples: over each sample step the difference quotient of q (of qd) lies between qd (qdd) at
 the step's ends (mean value theorem), within 1 % of the velocity limit (5 % of the peak acceleration).
 """
@@ -70,6 +71,28 @@ def robot_model(spec: dict, urdf: str) -> pin.Model:
     return pin.buildReducedModel(full, fixed, q) if fixed else full
 
 
+def rotation(quaternion: list[float]) -> np.ndarray:
+    """Rotation matrix of [x, y, z, w] through pinocchio (normalised)."""
+    x, y, z, w = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
+    return pin.Quaternion(w, x, y, z).toRotationMatrix()
+
+
+def obstacle_distance(obstacle: dict, points: np.ndarray) -> np.ndarray:
+    """Exact signed distance (m) of points (..., 3) to a scenario obstacle {sphere|box|cylinder: {...}}."""
+    (kind, o), = obstacle.items()
+    offset = points - np.array(o["center"])
+    if kind == "sphere":
+        return np.linalg.norm(offset, axis=-1) - o["radius"]
+    local = offset @ rotation(o.get("orientation", [0, 0, 0, 1]))  # rows: Rᵀ (p - c)
+    if kind == "box":
+        excess = np.abs(local) - np.array(o["size"]) / 2
+    else:  # cylinder along local z
+        excess = np.stack([np.hypot(local[..., 0], local[..., 1]) - o["radius"],
+                           np.abs(local[..., 2]) - o["length"] / 2], axis=-1)
+    outside = np.sqrt(np.sum(np.clip(excess, 0, None) ** 2, axis=-1))
+    return np.where(excess.max(axis=-1) > 0, outside, excess.max(axis=-1))
+
+
 def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, float]:
     """Worst value of every check: relative excess for limits, metres of penetration for geometry."""
     model = robot_model(spec, urdf)
@@ -100,8 +123,7 @@ def check(trajectory: dict, spec: dict, urdf: str, scenario: dict) -> dict[str, 
     worst["self_collision"] = max(0.0, -gaps.min())
     scene = scenario.get("scene", {})
     for obstacle in scene.get("obstacles", []):
-        o = obstacle["sphere"]
-        gap = np.linalg.norm(centres - np.array(o["center"]), axis=-1) - radii - o["radius"]
+        gap = obstacle_distance(obstacle, centres) - radii
         worst["obstacle"] = max(worst.get("obstacle", 0.0), -gap.min())
     if "workspace" in scene:
         box = scene["workspace"]

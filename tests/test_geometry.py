@@ -108,7 +108,7 @@ def test_collision_report_names_the_sphere_and_the_obstacle():
     centre = sphere_centers(ROBOT, HOME)[13]
     scene = Scene(np.array([[9.0, 9.0, 9.0], centre]), np.array([0.1, 0.05]))
     lines = collision_report(ROBOT, scene, HOME)
-    assert f"sphere 13 (link_5) overlaps obstacle 1 by {RADIUS[13] + 0.05:.3f} m" in lines
+    assert f"sphere 13 (link_5) overlaps obstacle 1 (sphere) by {RADIUS[13] + 0.05:.3f} m" in lines
     assert not any("obstacle 0" in line for line in lines)
 
 

@@ -50,3 +50,27 @@ def test_a_consistent_motion_passes_the_consistency_checks(tmp_path):
 def test_samples_that_are_not_derivatives_of_each_other_are_rejected(tmp_path, field, name, tolerance):
     worst = exported(tmp_path, scaled(polynomial_motion(FREE, 4.0, MINIMUM_JERK), field, 1.1))
     assert worst[name] > tolerance
+
+
+def test_outside_box_and_cylinder_distances_match_coal():
+    """The outside checker's own distances (numpy + pinocchio) against coal, tilted, inside and outside."""
+    import coal
+    from outside_check import obstacle_distance, rotation
+
+    rng = np.random.default_rng(8)
+    quaternion = rng.normal(size=4)
+    quaternion /= np.linalg.norm(quaternion)
+    center, R = np.array([0.3, -0.2, 0.5]), rotation(quaternion)
+    shapes = {"box": ({"size": [0.4, 0.2, 0.6]}, coal.Box(0.4, 0.2, 0.6)),
+              "cylinder": ({"radius": 0.15, "length": 0.5}, coal.Cylinder(0.15, 0.5))}
+    points = center + rng.uniform(-0.5, 0.5, (200, 3))
+    for kind, (fields, shape) in shapes.items():
+        ours = obstacle_distance({kind: {"center": center.tolist(), "orientation": quaternion.tolist(), **fields}},
+                                 points)
+        request = coal.DistanceRequest()
+        request.gjk_tolerance = 1e-10
+        theirs = np.array([coal.distance(shape, coal.Transform3s(R, center), coal.Capsule(1e-3, 1e-9),
+                                         coal.Transform3s(np.eye(3), p), request, coal.DistanceResult()) + 1e-3
+                           for p in points])
+        assert (theirs < 0).sum() > 10 and (theirs > 0).sum() > 10
+        np.testing.assert_allclose(ours, theirs, atol=1e-4)

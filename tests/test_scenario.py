@@ -83,7 +83,7 @@ def test_unknown_key_is_named(case1):
     (("scene",), {"obstacle": []}, r"unknown keys \['scene.obstacle'\]; allowed: \['obstacles', 'workspace'\]"),
     (("time",), {"maxx": 3}, r"unknown keys \['time.maxx'\]; allowed: \['guess', 'max', 'min'\]"),
     (("scene", "obstacles", 0, "sphere"), {"center": [1, 0, 0], "radious": 0.2},
-     r"unknown keys \['scene.obstacles\[0\].sphere.radious'\]; allowed: \['center', 'radius'\]"),
+     r"unknown keys \['scene.obstacles\[0\].sphere.radious'\]; allowed: \['center', 'name', 'radius'\]"),
 ])
 def test_an_unknown_nested_key_is_named_with_its_path(case1, where, value, message):
     parent = case1

@@ -2,6 +2,14 @@
 
 Distances are compared squared (smooth everywhere): ‖c_a − c_b‖² ≥ (r_a + r_b + margin)².
 
+Boxes and cylinders: one row per (robot sphere, obstacle), the squared outside distance of the sphere centre in
+the obstacle's frame, Σ_k max(|p_k| − h_k, 0)² ≥ (r + margin)² for a box of half sizes h (a cylinder: the radial
+excess √(p_x² + p_y²) − R and the axial excess |p_z| − L/2). Its feasible set is exactly the true one (no rounding,
+no conservatism) and it is continuously differentiable with a Lipschitz gradient (|·| and the norm's kink lie where
+max(·, 0) is already 0); only its second derivative jumps across the planes of the faces, which IPOPT tolerates.
+Its weakness: inside the obstacle the row is flat (zero gradient), so a guess deep inside a box gives IPOPT no
+direction there (the ladder's OMPL guess is the remedy). Rows and solve time: `ocpkit bench shapes` (README).
+
 Terms that can never be active are left out, which keeps the NLP (and IPOPT's KKT system) small: every
 robot sphere stays within its reach ρ of a fixed anchor (`ocpkit.robots.sphere_reach`), so a sphere whose
 reach ball cannot touch an obstacle or a workspace face gets no constraint for it. The kept terms are the
@@ -20,17 +28,21 @@ from ocpkit.problem import Problem
 from ocpkit.robots import sphere_reach
 
 MAX_MARGIN = 0.1  # m: the largest clearance margin the kept collision terms stay valid for
+RADIAL_EPS = 1e-12  # m²: under the cylinder's radial root (shifts it by < 1e-9 m where it counts, radii ≥ 1 mm)
 
 
 def active_terms(problem: Problem) -> tuple[np.ndarray, np.ndarray]:
     """Masks of the collision terms that can become active with a margin up to MAX_MARGIN: obstacles
-    (M, S), workspace faces [x, y, z min, x, y, z max] (M, 6), or (M, 0) without a workspace."""
+    (M, S + B + C: spheres, boxes, cylinders, each bounded by a sphere), workspace faces
+    [x, y, z min, x, y, z max] (M, 6), or (M, 0) without a workspace."""
     robot, scene = problem.robot, problem.scene
     anchors, reach = sphere_reach(robot)
     moving = (robot.sphere_joint > 0)[:, None]
     span = (reach + robot.sphere_radius + MAX_MARGIN)[:, None]
-    gaps = np.linalg.norm(anchors[:, None, :] - scene.obstacle_centers[None], axis=-1)
-    obstacles = (gaps <= span + scene.obstacle_radii[None, :]) & moving
+    centers = np.concatenate([scene.obstacle_centers, scene.boxes.centers, scene.cylinders.centers])
+    radii = np.concatenate([scene.obstacle_radii, scene.boxes.bounding_radii(), scene.cylinders.bounding_radii()])
+    gaps = np.linalg.norm(anchors[:, None, :] - centers[None], axis=-1)
+    obstacles = (gaps <= span + radii[None, :]) & moving
     if scene.workspace is None:
         return obstacles, np.zeros((len(reach), 0), dtype=bool)
     faces = np.hstack([anchors - scene.workspace.lower, scene.workspace.upper - anchors])
@@ -38,48 +50,85 @@ def active_terms(problem: Problem) -> tuple[np.ndarray, np.ndarray]:
 
 
 class SphereCollision(Constraint):
-    """Clearance ≥ margin (m) between robot spheres, to the S obstacle spheres and to the workspace box."""
+    """Clearance ≥ margin (m) between robot spheres, to the obstacles (spheres, boxes, cylinders) and to the
+    workspace box."""
 
     name = "collision"
 
     def __init__(self, problem: Problem) -> None:
         super().__init__(problem)
         self.obstacle_mask, self.face_mask = active_terms(problem)
+        scene = problem.scene
+        self.counts = (len(scene.obstacle_radii), len(scene.boxes), len(scene.cylinders))
         pairs = self.robot.self_collision
         self.pairs = pairs[(self.robot.sphere_joint[pairs] > 0).any(axis=1)] if len(pairs) else pairs
 
     def shape(self) -> tuple:
-        return self.obstacle_mask.shape, self.obstacle_mask.tobytes(), self.face_mask.shape, self.face_mask.tobytes()
+        return (self.counts, self.obstacle_mask.shape, self.obstacle_mask.tobytes(), self.face_mask.shape,
+                self.face_mask.tobytes())
 
     def parameter_shapes(self) -> dict[str, tuple[int, int]]:
-        obstacles = self.obstacle_mask.shape[1]
-        return {"obstacle_center": (obstacles, 3), "obstacle_radius": (obstacles, 1),
+        spheres, boxes, cylinders = self.counts
+        return {"obstacle_center": (spheres, 3), "obstacle_radius": (spheres, 1),
+                "box_center": (boxes, 3), "box_half_size": (boxes, 3), "box_rotation": (boxes, 9),
+                "cylinder_center": (cylinders, 3), "cylinder_half_size": (cylinders, 2),  # [radius, length / 2]
+                "cylinder_rotation": (cylinders, 9),  # rotations row-major
                 "workspace": (self.face_mask.shape[1], 1)}  # [lower (3), upper (3)] or nothing
 
     def parameter_values(self, problem: Problem) -> dict[str, np.ndarray]:
         scene = problem.scene
         box = [] if self.face_mask.shape[1] == 0 else [scene.workspace.lower, scene.workspace.upper]
+        boxes, cylinders = scene.boxes, scene.cylinders
         return {"obstacle_center": scene.obstacle_centers, "obstacle_radius": scene.obstacle_radii,
+                "box_center": boxes.centers, "box_half_size": 0.5 * boxes.sizes,
+                "box_rotation": boxes.rotations.reshape(-1, 9),
+                "cylinder_center": cylinders.centers,
+                "cylinder_half_size": np.column_stack([cylinders.radii, 0.5 * cylinders.lengths]),
+                "cylinder_rotation": cylinders.rotations.reshape(-1, 9),
                 "workspace": np.concatenate([np.zeros(0), *box])}
 
     def evaluate(self, point: PointValues, context: Context) -> Rows:
-        radius, margin = self.robot.sphere_radius, context.margin
+        radius, margin, p = self.robot.sphere_radius, context.margin, context.parameters
         centers = context.dynamics.sphere_centers(point.q)
-        obstacle_centers, obstacle_radii = context.parameters["obstacle_center"], context.parameters["obstacle_radius"]
         g = []
         for a, b in self.pairs:
             gap = centers[a, :] - centers[b, :]
             g.append(ca.dot(gap, gap) - (radius[a] + radius[b] + margin) ** 2)
+        spheres, boxes, _ = self.counts
         for m, s in zip(*np.nonzero(self.obstacle_mask)):
-            gap = centers[m, :] - obstacle_centers[s, :]
-            g.append(ca.dot(gap, gap) - (radius[m] + obstacle_radii[s] + margin) ** 2)
+            if s < spheres:
+                gap = centers[m, :] - p["obstacle_center"][s, :]
+                g.append(ca.dot(gap, gap) - (radius[m] + p["obstacle_radius"][s] + margin) ** 2)
+            else:
+                kind, k = ("box", s - spheres) if s < spheres + boxes else ("cylinder", s - spheres - boxes)
+                local = _local(centers[m, :], p[f"{kind}_center"][k, :], p[f"{kind}_rotation"][k, :])
+                outside = _outside_squared(local, p[f"{kind}_half_size"][k, :], kind == "cylinder")
+                g.append(outside - (radius[m] + margin) ** 2)
         upper = [np.inf] * len(g)
-        box = context.parameters["workspace"]
+        box = p["workspace"]
         for m, axis in zip(*np.nonzero(self.face_mask[:, :3] | self.face_mask[:, 3:])):
             g.append(_workspace_row(box, centers[m, axis], radius[m] + margin, axis, self.face_mask[m]))
             upper.append(1.0 if self.face_mask[m, axis] and self.face_mask[m, axis + 3] else np.inf)
         g = ca.vertcat(*g) if g else ca.SX(0, 1)
         return Rows(g, np.zeros(g.numel()), np.asarray(upper, dtype=float))
+
+
+def _local(c: ca.SX, center: ca.SX, rotation: ca.SX) -> ca.SX:
+    """Point c (1, 3) in the frame of an obstacle at `center` (1, 3) with row-major `rotation` (1, 9): (3, 1)."""
+    return ca.reshape(rotation, 3, 3) @ (c - center).T  # reshape is column-major: it gives Rᵀ
+
+
+def _outside_squared(local: ca.SX, half: ca.SX, cylinder: bool) -> ca.SX:
+    """Squared distance (m²) from a point (3, 1) in the obstacle's frame to a box of half sizes `half` (1, 3), or
+    to a cylinder of half = [radius, half length] along z; 0 inside. √(x² + y² + RADIAL_EPS) keeps the radial
+    term's derivative finite on the axis."""
+    if cylinder:
+        excess = ca.vertcat(ca.sqrt(local[0] ** 2 + local[1] ** 2 + RADIAL_EPS) - half[0],
+                            ca.fabs(local[2]) - half[1])
+    else:
+        excess = ca.fabs(local) - half.T
+    outside = ca.fmax(excess, 0)
+    return ca.dot(outside, outside)
 
 
 def _workspace_row(box: ca.SX, c: ca.SX, inset: ca.SX, axis: int, faces: np.ndarray) -> ca.SX:

@@ -155,3 +155,22 @@ def test_no_path_says_that_no_trajectory_was_found(case1):
     plan = plan_ompl_toppra(case1, planning_time=0.0)
     assert not plan.found and plan.stats.iterations == 0
     assert "no trajectory" in plan.stats.solver_message and "raise planning_time" in plan.hint
+
+
+def test_ompl_avoids_boxes_and_cylinders():
+    """On scenarios/shapes/boxes.yaml (the straight line hits the post) the validity checker agrees with the exact
+    distances and the path OMPL returns keeps clear of every box and cylinder at every dense sample."""
+    problem = ocpkit.load_scenario(REPO / "scenarios/shapes/boxes.yaml")
+    rng = np.random.default_rng(5)
+    configurations = rng.uniform(problem.robot.q_lower, problem.robot.q_upper, (300, problem.robot.n))
+    si = _space_information(problem, FreeSpace(problem, 0.0), resolution=0.01)
+    ompl_free = np.array([si.isValid(_state(si, q)) for q in configurations])
+    obstacle_free = clearances(problem.robot, problem.scene, sphere_centers(problem.robot, configurations)
+                               ).obstacles.min(axis=(1, 2)) >= 0
+    assert (~obstacle_free).sum() >= 20  # the boxes and cylinders do reject configurations
+    np.testing.assert_array_equal(ompl_free, verifier_says_free(problem, configurations))
+    line = problem.start + np.outer(np.linspace(0, 1, 101), problem.goal - problem.start)
+    assert not FreeSpace(problem, 0.0).free(line).all()
+    result = plan_ompl_toppra(problem, seed=0)
+    q = result.trajectory.sample(1e-3).q
+    assert clearances(problem.robot, problem.scene, sphere_centers(problem.robot, q)).obstacles.min() >= 0

@@ -12,9 +12,11 @@ from helpers import REPO
 import ocpkit
 from ocpkit.constraints import Context, PointValues
 from ocpkit.constraints.collision import MAX_MARGIN, SphereCollision, active_terms
+from ocpkit.distance import box_distance, cylinder_distance
+from ocpkit.quaternion import quaternion_matrix
 from ocpkit.dynamics import make_dynamics
 from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.scene import Scene, Workspace
+from ocpkit.scene import Boxes, Cylinders, Scene, Workspace
 
 PROBLEM = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
 ROBOT = PROBLEM.robot
@@ -41,15 +43,20 @@ def evaluate(constraint: SphereCollision, problem: ocpkit.Problem, q: np.ndarray
 
 
 def expected_rows(constraint: SphereCollision, problem: ocpkit.Problem, q: np.ndarray, margin: float) -> np.ndarray:
-    """Closed forms on pinocchio centres: ‖c_a − c_b‖² − (r_a + r_b + margin)² for self pairs and obstacles
-    (in mask order), then one workspace row per (sphere, axis) with a reachable face."""
+    """Closed forms on pinocchio centres: ‖c_a − c_b‖² − (r_a + r_b + margin)² for self pairs and obstacle
+    spheres, max(d, 0)² − (r + margin)² with d the exact (coal-tested) distance to a box or cylinder (in mask
+    order), then one workspace row per (sphere, axis) with a reachable face."""
     c, scene = sphere_centers(ROBOT, q), problem.scene
     rows = [np.sum((c[a] - c[b]) ** 2) - (RADIUS[a] + RADIUS[b] + margin) ** 2 for a, b in constraint.pairs]
+    outside = np.maximum(np.hstack([box_distance(c, scene.boxes), cylinder_distance(c, scene.cylinders)]), 0.0)
+    spheres = len(scene.obstacle_radii)
     for m in range(len(RADIUS)):
         for s in range(scene.n_obstacles):
-            if constraint.obstacle_mask[m, s]:
+            if constraint.obstacle_mask[m, s] and s < spheres:
                 rows.append(np.sum((c[m] - scene.obstacle_centers[s]) ** 2)
                             - (RADIUS[m] + scene.obstacle_radii[s] + margin) ** 2)
+            elif constraint.obstacle_mask[m, s]:
+                rows.append(outside[m, s - spheres] ** 2 - (RADIUS[m] + margin) ** 2)
     faces = constraint.face_mask
     for m in range(len(RADIUS)):
         for axis in range(3):
@@ -71,6 +78,41 @@ def test_rows_match_closed_form_clearances_at_random_configurations():
         g, lower, upper = evaluate(constraint, PROBLEM, q, margin=0.02)
         np.testing.assert_allclose(g, expected_rows(constraint, PROBLEM, q, 0.02), rtol=1e-9, atol=1e-12)
         assert lower.shape == upper.shape == g.shape and np.all(lower == 0)
+
+
+TILTED = quaternion_matrix([0.2, -0.3, 0.4, 0.8])
+PRIMITIVES = with_scene(boxes=Boxes(np.array([[1.0, 0.2, 0.9], [0.0, -0.9, 0.5]]), np.array([[0.3, 0.6, 0.2],
+                                                                                         [1.0, 0.2, 1.0]]),
+                                    np.stack([TILTED, np.eye(3)])),
+                        cylinders=Cylinders(np.array([[0.9, -0.4, 1.2]]), np.array([0.15]), np.array([0.8]),
+                                            TILTED[None]))
+
+
+def test_box_and_cylinder_rows_match_the_exact_outside_distance():
+    """At random configurations, many spheres inside (row −(r + margin)²) and outside the primitives."""
+    constraint = SphereCollision(PRIMITIVES)
+    assert constraint.obstacle_mask[:, 1:].sum() > 10  # boxes and cylinder give rows
+    rng = np.random.default_rng(4)
+    for q in rng.uniform(ROBOT.q_lower, ROBOT.q_upper, (4, N)):
+        g, _, _ = evaluate(constraint, PRIMITIVES, q, margin=0.02)
+        np.testing.assert_allclose(g, expected_rows(constraint, PRIMITIVES, q, 0.02), rtol=1e-9, atol=1e-12)
+
+
+def test_box_and_cylinder_rows_have_finite_gradients_everywhere():
+    """On a cylinder's axis and on the planes of a box's faces the smooth rows still differentiate."""
+    constraint = SphereCollision(PRIMITIVES)
+    assert constraint.obstacle_mask[-1, -1]  # the last sphere has a row for the cylinder
+    point = PointValues(*(ca.SX.sym(k, N) for k in ("q", "qd", "qdd", "tau", "dtau_ds")), ca.SX.sym("dt_ds"))
+    shapes = constraint.parameter_shapes()
+    symbols = {name: ca.SX.sym(name, *shape) for name, shape in shapes.items()}
+    rows = constraint.evaluate(point, Context(make_dynamics("casadi", ROBOT), 0.0, ca.SX.sym("s"), symbols))
+    jacobian = ca.Function("j", [point.q, *symbols.values()], [ca.jacobian(rows.g, point.q)])
+    values = constraint.parameter_values(PRIMITIVES)
+    c = sphere_centers(ROBOT, PROBLEM.start)
+    on_axis = dataclasses.replace(PRIMITIVES.scene.cylinders, centers=c[-1][None] + TILTED[:, 2] * 0.1)
+    values["cylinder_center"] = on_axis.centers
+    J = np.asarray(jacobian(PROBLEM.start, *(np.reshape(values[name], shapes[name]) for name in symbols)))
+    assert np.all(np.isfinite(J))
 
 
 def test_obstacle_row_is_zero_when_the_sphere_touches_the_obstacle_with_margin():
@@ -106,7 +148,10 @@ def test_workspace_rows_are_within_unit_interval_inside_the_box():
 
 def test_parameters_are_the_obstacles_and_the_box_by_name():
     constraint = SphereCollision(PROBLEM)
-    assert constraint.parameter_shapes() == {"obstacle_center": (1, 3), "obstacle_radius": (1, 1), "workspace": (6, 1)}
+    assert constraint.parameter_shapes() == {
+        "obstacle_center": (1, 3), "obstacle_radius": (1, 1), "box_center": (0, 3), "box_half_size": (0, 3),
+        "box_rotation": (0, 9), "cylinder_center": (0, 3), "cylinder_half_size": (0, 2), "cylinder_rotation": (0, 9),
+        "workspace": (6, 1)}
     values = constraint.parameter_values(PROBLEM)
     np.testing.assert_array_equal(values["obstacle_center"], PROBLEM.scene.obstacle_centers)
     np.testing.assert_array_equal(values["obstacle_radius"], PROBLEM.scene.obstacle_radii)

@@ -1,0 +1,36 @@
+"""Exact signed distances (m) from points to oriented boxes and cylinders.
+
+Negative inside (minus the depth to the nearest face). This is the numeric reference `geometry.clearances` (and so
+`verify`, validation and the OMPL validity checker) uses; the NLP uses a smooth form (constraints/collision.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ocpkit.scene import Boxes, Cylinders
+
+
+def _local(points: np.ndarray, centers: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """Points (..., 3) in each primitive's frame: shape (..., P, 3)."""
+    return np.einsum("pji,...pj->...pi", rotations, points[..., None, :] - centers)
+
+
+def _signed(excess: np.ndarray) -> np.ndarray:
+    """Signed distance from per-axis excesses (..., k) beyond the faces: outside the norm of the positive parts,
+    inside the largest (negative) excess."""
+    return np.linalg.norm(np.maximum(excess, 0.0), axis=-1) + np.minimum(excess.max(axis=-1), 0.0)
+
+
+def box_distance(points: np.ndarray, boxes: Boxes) -> np.ndarray:
+    """Signed distance of points (..., 3) to each box: shape (..., B)."""
+    p = _local(points, boxes.centers, boxes.rotations)
+    return _signed(np.abs(p) - 0.5 * boxes.sizes)
+
+
+def cylinder_distance(points: np.ndarray, cylinders: Cylinders) -> np.ndarray:
+    """Signed distance of points (..., 3) to each cylinder: shape (..., C)."""
+    p = _local(points, cylinders.centers, cylinders.rotations)
+    radial = np.linalg.norm(p[..., :2], axis=-1) - cylinders.radii
+    axial = np.abs(p[..., 2]) - 0.5 * cylinders.lengths
+    return _signed(np.stack([radial, axial], axis=-1))
