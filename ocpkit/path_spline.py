@@ -9,6 +9,7 @@ exact wherever s is), so the timing NLP and the samples it returns see the same 
 
 from __future__ import annotations
 
+import hashlib
 from math import factorial
 
 import casadi as ca
@@ -38,6 +39,11 @@ class PathSpline:
         breaks = np.unique(np.clip(curve.t, 0.0, 1.0))
         coefficients = np.stack([curve(breaks[:-1], nu=j) / factorial(j) for j in range(DEGREE + 1)], axis=1)
         return cls(breaks, coefficients, length)
+
+    @property
+    def key(self) -> str:
+        """A digest of the breakpoints and coefficients: equal exactly for equal splines."""
+        return hashlib.sha256(self.breaks.tobytes() + self.coefficients.tobytes()).hexdigest()
 
     def __call__(self, chord: np.ndarray) -> np.ndarray:
         """p at chord lengths (m,), rad: (m, n)."""

@@ -45,7 +45,7 @@ OMPL and toppra are optional dependencies, imported on first use (toppra is slow
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
@@ -108,6 +108,12 @@ def _coarse_to_fine(count: int) -> np.ndarray:
     """The indices 1..count: count first, then the others by decreasing power of two dividing them."""
     inner = np.arange(1, count)
     return np.concatenate([[count], inner[np.argsort(-(inner & -inner), kind="stable")]])
+
+
+def planning_space(problem: Problem, margin: float) -> FreeSpace:
+    """The FreeSpace OMPL plans in: `margin` (m), lowered to the start's or goal's clearance if that is smaller."""
+    ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
+    return FreeSpace(problem, min(margin, float(ends.min())))
 
 
 # -- OMPL ---------------------------------------------------------------------------------------------
@@ -207,17 +213,24 @@ def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_ti
 # -- smooth path --------------------------------------------------------------------------------------
 
 
-def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float) -> tuple[Any, int]:
-    """A clamped cubic spline through `waypoints` (k, n), parametrised by chord length (rad), that keeps half
-    the margin at checks every resolution/4 rad; returns (toppra path, repair rounds used).
-
-    After the last round the spline is returned as it is; `verify` then reports any contact."""
+def _clamped_cubic(chord: np.ndarray, waypoints: np.ndarray) -> Any:
+    """toppra's clamped cubic spline through `waypoints` (k, n) at chord lengths `chord` (k,), rad."""
     from toppra.interpolator import SplineInterpolator
 
+    return SplineInterpolator(chord, waypoints, bc_type="clamped")
+
+
+def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float,
+                 fit: Callable[[np.ndarray, np.ndarray], Any] = _clamped_cubic) -> tuple[Any, int]:
+    """A spline `fit(chord, waypoints)` (a clamped cubic by default) through `waypoints` (k, n), parametrised by
+    chord length (rad), that keeps half the margin at checks every resolution/4 rad (the spline called with chord
+    lengths); returns (the spline, repair rounds used).
+
+    After the last round the spline is returned as it is; `verify` then reports any contact."""
     waypoints = waypoints[np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 0])]
     for rounds in range(REPAIR_ROUNDS + 1):
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
-        path = SplineInterpolator(chord, waypoints, bc_type="clamped")
+        path = fit(chord, waypoints)
         checks = np.linspace(0.0, chord[-1], int(np.ceil(4 * chord[-1] / resolution)) + 1)
         bad = checks[free.clearance(path(checks)) < free.margin / 2]
         if not len(bad) or rounds == REPAIR_ROUNDS:
@@ -335,8 +348,7 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     if np.array_equal(problem.start, problem.goal):
         return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
     setup = _import_backends()
-    ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
-    free = FreeSpace(problem, min(margin, float(ends.min())))
+    free = planning_space(problem, margin)
     found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution)
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
              "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,

@@ -215,4 +215,4 @@ class MeshTranscription(Transcription):
     def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
               ocp: OCP | None = None) -> MeshDiscretization:
         return self.discretization(problem, dynamics, constraints, self.knots, self.margin, self.staged,
-                                   self.shape_key(dynamics, constraints), ocp or RobotOCP(problem.robot))
+                                   self.shape_key(dynamics, constraints, ocp), ocp or RobotOCP(problem.robot))

@@ -53,6 +53,11 @@ class OCP(ABC):
         self.robot = robot
 
     @property
+    @abstractmethod
+    def key(self) -> tuple:
+        """Hashable, equal exactly when two OCPs give the same NLP for the same transcription and robot."""
+
+    @property
     def width(self) -> int:
         """Values of one node [x, ẋ, ẍ, u]: 3m + n."""
         return 3 * self.chain + self.robot.n
@@ -115,6 +120,10 @@ class RobotOCP(OCP):
         super().__init__(robot)
         self.chain = robot.n
 
+    @property
+    def key(self) -> tuple:
+        return ("robot",)
+
     def robot_state(self, x: Node) -> tuple[ca.SX, ca.SX, ca.SX]:
         return x.q, x.qd, x.qdd
 
@@ -147,6 +156,10 @@ class PathTimingOCP(OCP):
     def __init__(self, robot: Robot, path: PathSpline) -> None:
         super().__init__(robot)
         self.path = path
+
+    @property
+    def key(self) -> tuple:
+        return "path-timing", self.path.key
 
     def robot_state(self, x: Node) -> tuple[ca.SX, ca.SX, ca.SX]:
         p, dp, ddp, _ = self.path.symbolic(x.q)

@@ -219,4 +219,4 @@ class Pseudospectral(Transcription):
               ocp: OCP | None = None) -> PseudospectralDiscretization:
         return PseudospectralDiscretization(problem, dynamics, constraints, Grid(self.family, self.knots,
                                             self.segments), self.margin, self.adaptive_checks,
-                                            self.shape_key(dynamics, constraints), ocp or RobotOCP(problem.robot))
+                                            self.shape_key(dynamics, constraints, ocp), ocp or RobotOCP(problem.robot))
