@@ -6,12 +6,13 @@ against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP 
 
 - the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, ...];
 - the nodes [x, ẋ, ẍ, u] (the OCP's chain and the scaled rigid-body torque u);
-- the values at a point, `point(node, du_ds, dt_ds)`: the robot's (q, q̇, q̈) = ocp.robot_state(node), joint
-  torque τ = τ_max ∘ u + friction(q̇) and its rate dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈, where dt/ds
-  is the transcription's (t_f/(2K) on a pseudospectral segment, h = t_f/N on a mesh interval), so rate bounds
-  read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f never divides;
+- the values at a point, `point(node, slope, dt_ds)`: the robot's (q, q̇, q̈) = ocp.robot_state(node), joint
+  torque τ and its rate dτ/ds as the OCP gives them (`OCP.torque`; for the robot OCP τ = τ_max ∘ u +
+  friction(q̇) and dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈) from the interpolant's slopes du/ds and
+  dẍ/ds (`Slope`), where dt/ds is the transcription's (t_f/(2K) on a pseudospectral segment, h = t_f/N on a
+  mesh interval), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f never divides;
 - the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base);
-- the dynamic defect residual(q, q̇, q̈, τ_max u) at a collocation point;
+- the OCP's rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) = 0);
 - the robot's jerk times dt/ds at a point (`jerk_s`), which the jerk cost integrates;
 - the rows lbg ≤ g ≤ ubg in the order they were added, and the finished `NLP`.
 """
@@ -27,9 +28,9 @@ from ocpkit.constraints import Constraint, Context, PointValues, Rows
 from ocpkit.dynamics import Dynamics
 from ocpkit.nlp import NLP, Layout, Stages
 from ocpkit.problem import Problem
-from ocpkit.transcription.ocp import OCP, Node, RobotOCP
+from ocpkit.transcription.ocp import OCP, Node, RobotOCP, Slope
 
-__all__ = ["Assembly", "Node"]
+__all__ = ["Assembly", "Node", "Slope"]
 
 
 class Assembly:
@@ -44,10 +45,7 @@ class Assembly:
         self.contexts = [Context(dynamics, margin, limit_scale, {
             name: self.p.add(f"{c.name}.{name}", *shape) for name, shape in c.parameter_shapes().items()})
             for c in self.constraints]
-        self.tau_max = ca.DM(self.robot.tau_max)
-        v, a = ca.SX.sym("qd", self.robot.n), ca.SX.sym("qdd", self.robot.n)  # friction'(q̇) a by AD of the law
-        self._friction = ca.Function("friction", [v], [dynamics.friction(v)])
-        self._friction_rate = ca.Function("friction_rate", [v, a], [ca.jtimes(dynamics.friction(v), v, a)])
+        self._torque = self.ocp.torque(dynamics)
         self.g: list[ca.SX] = []
         self.lbg: list[np.ndarray] = []
         self.ubg: list[np.ndarray] = []
@@ -86,33 +84,32 @@ class Assembly:
         self.add(Rows(expr, 0.0, 0.0))
 
     def dynamics_defect(self, x: Node) -> None:
-        """The dynamics at one collocation point: residual(q, q̇, q̈, τ_max u) = 0."""
-        self.defect(self.dynamics.residual(*self.ocp.robot_state(x), self.tau_max * x.u))
+        """The OCP's rows at one collocation point (`OCP.defect`: the dynamics for the robot OCP) = 0."""
+        self.defect(self.ocp.defect(self.dynamics, x))
 
     def jerk_s(self, x: Node, dxdd_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
         """The robot's jerk times dt/ds (n, 1) at a point where the chain's ẍ has slope dẍ/ds = `dxdd_ds`."""
         return self.ocp.jerk_s(x, dxdd_ds, dt_ds)
 
-    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> PointValues:
-        """Values at one point; du_ds is du/ds, so dτ/ds = τ_max du_ds + friction'(q̇) (dt/ds) q̈."""
-        q, qd, qdd = self.ocp.robot_state(x)
-        return PointValues(q, qd, qdd, self.tau_max * x.u + self._friction(qd),
-                           self.tau_max * du_ds + self._friction_rate(qd, dt_ds * qdd), dt_ds)
+    def point(self, x: Node, slope: Slope, dt_ds: ca.SX) -> PointValues:
+        """Values at one point where the interpolant has the slopes `slope` (du/ds, dẍ/ds)."""
+        tau, dtau_ds = self._torque(x, slope, dt_ds)
+        return PointValues(*self.ocp.robot_state(x), tau, dtau_ds, dt_ds)
 
-    def path(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, at_knot: bool = False) -> None:
+    def path(self, x: Node, slopes: Sequence[Slope], dt_ds: ca.SX, at_knot: bool = False) -> None:
         """Every path constraint at one point, in the constraints' order: those not reading rates once (at a
         knot, less those imposed as knot bounds where the OCP's chain is q), those reading dτ/ds once per
-        one-sided slope du/ds in `slopes` (none without slopes)."""
+        one-sided slope in `slopes` (none without slopes)."""
         first, *others = [self.point(x, slope, dt_ds) for slope in slopes] or [
-            self.point(x, ca.SX.zeros(self.robot.n), dt_ds)]
+            self.point(x, Slope(ca.SX.zeros(self.ocp.algebraic), ca.SX.zeros(self.ocp.chain)), dt_ds)]
         for constraint, context in zip(self.constraints, self.contexts):
             if _imposed(constraint, bool(slopes), at_knot and self.ocp.knot_bounds):
                 self.add(constraint.evaluate(first, context))
         for values in others:
             self._rates(values)
 
-    def rates(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX) -> None:
-        """The constraints reading dτ/ds at one point, once per one-sided slope du/ds in `slopes`."""
+    def rates(self, x: Node, slopes: Sequence[Slope], dt_ds: ca.SX) -> None:
+        """The constraints reading dτ/ds at one point, once per one-sided slope in `slopes`."""
         for slope in slopes:
             self._rates(self.point(x, slope, dt_ds))
 

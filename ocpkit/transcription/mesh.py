@@ -25,7 +25,7 @@ from ocpkit.dynamics import Dynamics
 from ocpkit.nlp import Refinement, Stages
 from ocpkit.problem import Problem
 from ocpkit.trajectory import Samples, Trajectory
-from ocpkit.transcription.assembly import Assembly, Node
+from ocpkit.transcription.assembly import Assembly, Node, Slope
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP
 
@@ -42,6 +42,11 @@ class Local(NamedTuple):
     u: Any
     du_ds: Any
     dqdd_ds: Any
+
+    @property
+    def slope(self) -> Slope:
+        """(du/dσ, dẍ/dσ)."""
+        return Slope(self.du_ds, self.dqdd_ds)
 
 
 Interpolate = Callable[[Node, Node, "Node | None", Any, Any], Local]
@@ -62,7 +67,7 @@ class MeshInterpolant:
         node = self.ocp.split
         mid = None if self.mids is None else node(self.mids[k])
         v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, h, (at - k)[:, None])
-        return self.ocp.samples(t, Node(v.q, v.qd, v.qdd, v.u), v.du_ds / h)
+        return self.ocp.samples(t, Node(v.q, v.qd, v.qdd, v.u), v.du_ds / h, v.dqdd_ds / h)
 
 
 class MeshDiscretization(Discretization):
@@ -108,14 +113,14 @@ class MeshDiscretization(Discretization):
             else:
                 end = ends[k] if staged else x[k + 1]
                 local = lambda s: self.interpolate(x[k], end, mids[k], h, s)  # noqa: E731
-                a.path(x[k], [local(0.0).du_ds], h, at_knot=True)  # the slope leaving knot k
+                a.path(x[k], [local(0.0).slope], h, at_knot=True)  # the slope leaving knot k
                 self.collocation(a, h, x[k], end, mids[k])
                 if self.midpoints:
                     a.dynamics_defect(mids[k])
                 v = local(check_at[k])
                 a.defect(checks[k] - v.q)
-                a.path(Node(checks[k], v.qd, v.qdd, v.u), [v.du_ds], h)
-                a.rates(end, [local(1.0).du_ds], h)  # the slope entering knot k + 1
+                a.path(Node(checks[k], v.qd, v.qdd, v.u), [v.slope], h)
+                a.rates(end, [local(1.0).slope], h)  # the slope entering knot k + 1
                 jerk += self._jerk_integral(a, local, h, ca.DM(problem.jerk_weights)) / h
             rows.append(a.row_count - first)
         stages = None

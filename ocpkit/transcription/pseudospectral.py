@@ -26,7 +26,7 @@ from ocpkit.errors import OptionError
 from ocpkit.nlp import Refinement
 from ocpkit.problem import Problem
 from ocpkit.trajectory import Samples, Trajectory
-from ocpkit.transcription.assembly import Assembly, Node
+from ocpkit.transcription.assembly import Assembly, Node, Slope
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP
 from ocpkit.transcription.polynomials import NodeFamily
@@ -78,9 +78,9 @@ class PseudospectralInterpolant:
 
     def __call__(self, t: np.ndarray) -> Samples:
         L, Ld = self.grid.matrices(2.0 * np.asarray(t, dtype=float) / self.tf - 1.0)
-        values = L @ self.columns.T
-        du_dt = Ld @ self.columns[3 * self.ocp.chain:].T * (2.0 * self.grid.K / self.tf)
-        return self.ocp.samples(t, self.ocp.split(values), du_dt)
+        values, rates = L @ self.columns.T, Ld @ self.columns.T * (2.0 * self.grid.K / self.tf)
+        m = self.ocp.chain
+        return self.ocp.samples(t, self.ocp.split(values), rates[:, 3 * m:], rates[:, 2 * m:3 * m])
 
 
 def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
@@ -125,11 +125,12 @@ class PseudospectralDiscretization(Discretization):
                 if collocated[i]:
                     a.defect(q_defect[i, :].T)
                     a.defect(qd_defect[i, :].T)
+                slope = Slope(du_ds[i, :].T, dqdd_ds[i, :].T)
                 if b > 0 and i == 0:  # the joint with segment b − 1: its other one-sided torque rate
-                    a.rates(node, [du_ds[i, :].T], h)
+                    a.rates(node, [slope], h)
                 else:
                     a.dynamics_defect(node)
-                    a.path(node, [du_ds[i, :].T], h, at_knot=True)
+                    a.path(node, [slope], h, at_knot=True)
                 jerk_s.append(a.jerk_s(node, dqdd_ds[i, :].T, h))  # from (D Ẍ_b) point by point; jerk = jerk_s / h
 
         fixed_rows, fixed_drows = grid.matrices(self.check_sigma)
@@ -138,7 +139,8 @@ class PseudospectralDiscretization(Discretization):
         for k in range(L.size1()):
             row, drow = ca.transpose(L[k, :]), ca.transpose(Ld[k, :])
             a.defect(Qc[:, k] - ca.mtimes(Q, row))
-            a.path(Node(Qc[:, k], ca.mtimes(Qd, row), ca.mtimes(Qdd, row), ca.mtimes(U, row)), [ca.mtimes(U, drow)], h)
+            a.path(Node(Qc[:, k], ca.mtimes(Qd, row), ca.mtimes(Qdd, row), ca.mtimes(U, row)),
+                   [Slope(ca.mtimes(U, drow), ca.mtimes(Qdd, drow))], h)
 
         quad = ca.DM(np.kron(np.tile(weights, K), problem.jerk_weights))
         objective = tf + a.mu * (2.0 * K / tf) * ca.dot(quad, ca.vertcat(*jerk_s) ** 2)
