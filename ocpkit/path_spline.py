@@ -3,8 +3,10 @@
 `PathSpline.fit` interpolates waypoints by a quintic spline (C⁴: p‴ is continuous) in the chord length c (rad),
 with p′ = p″ = 0 at both ends. Its normalised parameter is s = c / L (L the chord length of the whole path).
 Both evaluations use one piecewise polynomial in s (the spline's own Taylor coefficients at every breakpoint):
-`values` in NumPy, `symbolic` on a CasADi scalar (the interval selected by comparisons, so the expression is
-exact wherever s is), so the timing NLP and the samples it returns see the same p, p′, p″, p‴.
+`values` in NumPy, `symbolic` on CasADi symbols for s, the breakpoints and the coefficients (the interval
+selected by comparisons, so the expression is exact wherever s is; the breakpoints and coefficients are NLP
+parameters, `parameters`), so the timing NLP and the samples it returns see the same p, p′, p″, p‴. `split`
+cuts intervals in two (the same polynomial) so paths of different lengths share one NLP shape.
 """
 
 from __future__ import annotations
@@ -45,27 +47,55 @@ class PathSpline:
         """A digest of the breakpoints and coefficients: equal exactly for equal splines."""
         return hashlib.sha256(self.breaks.tobytes() + self.coefficients.tobytes()).hexdigest()
 
+    @property
+    def intervals(self) -> int:
+        """K, the polynomial pieces."""
+        return len(self.breaks) - 1
+
+    def split(self, intervals: int) -> PathSpline:
+        """The same path on `intervals` ≥ K pieces: the longest piece halved until there are that many."""
+        breaks = self.breaks
+        while len(breaks) - 1 < intervals:
+            i = int(np.argmax(np.diff(breaks)))
+            breaks = np.insert(breaks, i + 1, (breaks[i] + breaks[i + 1]) / 2)
+        return PathSpline(breaks, self.taylor(breaks[:-1]), self.length)
+
+    def taylor(self, s: np.ndarray) -> np.ndarray:
+        """p^(j)(s)/j! for j = 0..DEGREE at s (m,): (m, DEGREE+1, n) (the piece starting at s where s is a break)."""
+        interval, local = self._locate(s)
+        return np.stack([_horner(self.coefficients[interval], local, d) / factorial(d) for d in range(DEGREE + 1)],
+                        axis=1)
+
+    def parameters(self) -> tuple[np.ndarray, np.ndarray]:
+        """The NLP parameter values `symbolic` reads: breaks (K+1, 1) and coefficients ((DEGREE+1) n, K), rows
+        j n .. (j+1) n − 1 holding the coefficients of (s − b_i)^j of piece i."""
+        return self.breaks[:, None], np.concatenate([self.coefficients[:, j, :].T for j in range(DEGREE + 1)])
+
     def __call__(self, chord: np.ndarray) -> np.ndarray:
         """p at chord lengths (m,), rad: (m, n)."""
         return self.values(np.asarray(chord, dtype=float) / self.length)[0]
 
     def values(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """p, p′, p″, p‴ at s (m,), each (m, n) (derivatives in s; outside [0, 1] the end polynomials)."""
+        interval, local = self._locate(s)
+        return tuple(_horner(self.coefficients[interval], local, d) for d in range(4))
+
+    def _locate(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The piece of each s (m,) and s − its start, (m, 1)."""
         s = np.asarray(s, dtype=float)
         interval = np.clip(np.searchsorted(self.breaks, s, side="right") - 1, 0, len(self.breaks) - 2)
-        local = (s - self.breaks[interval])[:, None]
-        coefficients = self.coefficients[interval]  # (m, DEGREE+1, n)
-        return tuple(_horner(coefficients, local, d) for d in range(4))
+        return interval, (s - self.breaks[interval])[:, None]
 
-    def symbolic(self, s: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX, ca.SX]:
-        """p, p′, p″, p‴ at the CasADi scalar s, each (n, 1)."""
-        K = len(self.breaks) - 1
-        select = [(1 if i == 0 else s >= self.breaks[i]) * (1 if i == K - 1 else s < self.breaks[i + 1])
-                  for i in range(K)]
-        onehot = ca.vertcat(*select)
-        local = s - ca.dot(onehot, ca.DM(self.breaks[:-1]))
-        rows = [ca.mtimes(ca.DM(self.coefficients[:, j, :].T), onehot) for j in range(DEGREE + 1)]  # (n, 1) each
-        return tuple(_horner(rows, local, d) for d in range(4))
+
+def symbolic(s: ca.SX, breaks: ca.SX, coefficients: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX, ca.SX]:
+    """p, p′, p″, p‴ (n, 1) at the CasADi scalar s of the path whose `PathSpline.parameters` are the symbols
+    `breaks` (K+1, 1) and `coefficients` ((DEGREE+1) n, K)."""
+    K, n = breaks.numel() - 1, coefficients.size1() // (DEGREE + 1)
+    select = [(1 if i == 0 else s >= breaks[i]) * (1 if i == K - 1 else s < breaks[i + 1]) for i in range(K)]
+    onehot = ca.vertcat(*select)
+    local = s - ca.dot(onehot, breaks[:K])
+    rows = [ca.mtimes(coefficients[j * n:(j + 1) * n, :], onehot) for j in range(DEGREE + 1)]  # (n, 1) each
+    return tuple(_horner(rows, local, d) for d in range(4))
 
 
 def _horner(coefficients: object, local: object, derivative: int) -> object:

@@ -9,8 +9,10 @@
    rest at 1, q̇ = p′ṡ, q̈ = p′s̈ + p″ṡ², q⃛ = p′s⃛ + 3p″ṡs̈ + p‴ṡ³, τ = RNEA(q, q̇, q̈) + friction; the
    velocity, torque and torque-rate limits and the cost t_f + μ∫q⃛ᵀQq⃛ dt of the simultaneous planner. It is
    transcribed and solved by ocpkit's own transcriptions and solvers (the same arguments as
-   `plan_simultaneous`: transcription, knots, dynamics, solver, ...), built through the same cache, solved with
-   the same refinement rounds, warm-started from the TOPP-RA profile of the same path (`_time_optimal`).
+   `plan_simultaneous`: transcription, knots, dynamics, solver, ...), solved with the same refinement rounds,
+   warm-started from the TOPP-RA profile of the same path (`_time_optimal`). The path enters the NLP as
+   parameters, its pieces split up to a multiple of PIECES_STEP, so paths share one build (the build cache's,
+   like the simultaneous planner's shapes) and its one-time set-up is not computation.
    Collision is not a constraint of the timing: the path is fixed and was checked; `verify` checks it again.
 
 The motion returned is q(t) = p(s(t)) at every sample, so it stays on the checked path by construction.
@@ -35,6 +37,7 @@ from ocpkit.solvers import SolverStatus
 from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription.ocp import PathTimingOCP
 
+PIECES_STEP = 4  # the path's polynomial pieces are rounded up to a multiple of this: one NLP per multiple
 TIMING_CONSTRAINTS = ("state-limits", "torque", "torque-rate")
 """The simultaneous planner's limits; collision is left to the path (fixed and checked) and to `verify`."""
 
@@ -96,14 +99,15 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": solver}
     if np.array_equal(problem.start, problem.goal):
         return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
-    setup = _import_backends()  # one-time set-up; the timing NLP is built per path, so its build is computation
+    setup = _import_backends()
     free = planning_space(problem, margin)
     found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution)
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "margin_m": free.margin}
     if found.waypoints is None:
         return finish(problem, _hold(problem), "no_path", method, began, setup_time=setup, extra=extra, found=False,
                       message=f"{planner_name}: no exact path within {planning_time:g} s; the plan holds the start")
-    path, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit)
+    smooth, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit)
+    path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
     timed = _time_optimal(problem, ToppraPath(path), grid_points)
     extra.update(waypoints=len(found.waypoints), repair_rounds=rounds, toppra_tf_s=np.nan)
     if timed is None:
@@ -111,17 +115,17 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
                       found=False, message="TOPP-RA cannot time the smoothed path: no warm start; the plan holds "
                       "the start")
     extra["toppra_tf_s"] = float(timed[1][-1])
-    building = time.perf_counter()
+    ocp = PathTimingOCP(problem.robot, path)
     made = build(problem, transcription, knots, dynamics, solver, TIMING_CONSTRAINTS, transcription_options,
-                 solver_options, dynamics_options, ocp=PathTimingOCP(problem.robot, path))
-    extra["timing_build_s"] = time.perf_counter() - building
-    w = made.discretization.encode(toppra_profile(timed[0]))
-    refined = solve_refined(made.discretization, made.solver, problem, w, refinements,
+                 solver_options, dynamics_options, ocp=ocp)
+    discretization = made.discretization.with_ocp(ocp)
+    w = discretization.encode(toppra_profile(timed[0]))
+    refined = solve_refined(discretization, made.solver, problem, w, refinements,
                             time.perf_counter() + max_wall_time)
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; timing: "
                f"{result.message}")
-    return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup,
+    return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + made.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=message, extra=extra,
                   verification=refined.verification)

@@ -4,7 +4,7 @@ A transcription creates its variables through `Assembly.w` (a Layout: the order 
 w) and adds its rows in the order it wants them; the assembly supplies the rest the same way for all, written
 against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP unless told otherwise):
 
-- the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, ...];
+- the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, the OCP's, ...];
 - the nodes [x, ẋ, ẍ, u] (the OCP's chain and the scaled rigid-body torque u);
 - the values at a point, `point(node, slope, dt_ds)`: the robot's (q, q̇, q̈) = ocp.robot_state(node), joint
   torque τ and its rate dτ/ds as the OCP gives them (`OCP.torque`; for the robot OCP τ = τ_max ∘ u +
@@ -45,6 +45,8 @@ class Assembly:
         self.contexts = [Context(dynamics, margin, limit_scale, {
             name: self.p.add(f"{c.name}.{name}", *shape) for name, shape in c.parameter_shapes().items()})
             for c in self.constraints]
+        self.ocp.use_parameters({name: self.p.add(f"ocp.{name}", *shape)
+                                 for name, shape in self.ocp.parameter_shapes().items()})
         self._torque = self.ocp.torque(dynamics)
         self.g: list[ca.SX] = []
         self.lbg: list[np.ndarray] = []

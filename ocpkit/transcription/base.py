@@ -9,6 +9,7 @@ one prepared solver). The equations of every transcription are in docs/transcrip
 
 from __future__ import annotations
 
+import copy
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from itertools import count
@@ -35,8 +36,8 @@ class Discretization(ABC):
       variables   the OCP's chain parts ("q", "qd", "qdd" for the robot OCP) (knots, m) and "u" (knots, n) at
                   every knot;  "start", "goal": [x, ẋ, ẍ] (3m,) at the start and goal knots;  "tf": every copy
                   of t_f
-      parameters  "mu", "margin", "limit_scale", "<constraint>.<name>" per constraint, then the transcription's
-                  own (`own_parameters`)
+      parameters  "mu", "margin", "limit_scale", "<constraint>.<name>" per constraint, "ocp.<name>" per OCP
+                  parameter, then the transcription's own (`own_parameters`)
 
     `margin` (m) is the default clearance margin; `ocp` the OCP discretized (ocpkit.transcription.ocp)."""
 
@@ -73,9 +74,18 @@ class Discretization(ABC):
         shared = {"mu": problem.mu, "margin": margin, "limit_scale": refinement.limit_scale}
         owned = {f"{c.name}.{name}": value for c in self.constraints for name, value in
                  c.parameter_values(problem).items()}
+        owned.update({f"ocp.{name}": value for name, value in self.ocp.parameter_values().items()})
         for name, value in {**shared, **owned, **self.own_parameters(refinement)}.items():
             p.write(values, name, value)
         return values
+
+    def with_ocp(self, ocp: OCP) -> Discretization:
+        """This discretization for another OCP of the same key (its numbers: parameters, encode, decode)."""
+        if ocp.key != self.ocp.key:
+            raise ValueError(f"an OCP of key {ocp.key} cannot use the NLP built for key {self.ocp.key}")
+        other = copy.copy(self)
+        other.ocp = ocp
+        return other
 
     def initial_guess(self, problem: Problem) -> np.ndarray:
         """The OCP's default guess (`OCP.guess`): for the robot OCP the paper's straight joint-space line over

@@ -13,7 +13,9 @@ and algebraic variables u (`algebraic` values, possibly none). An OCP gives
 - `knot_bounds`: whether constraints imposed as knot bounds (`at_knots = "bounds"`) can be bounds of the
   chain (x is q) or must be rows at the knots;
 - `end_values` (x, ẋ, ẍ at start and goal, both at rest), `chain_bounds` (other bounds on chain parts) and
-  `guess` (a chain trajectory to start from).
+  `guess` (a chain trajectory to start from);
+- its own NLP parameters (`parameter_shapes`, `parameter_values`; the assembly hands the OCP their symbols by
+  `use_parameters` before the build), so OCPs of one `key` share one NLP.
 
 Two instances: `RobotOCP` (x = q, the paper's problem; u = rnea(q, q̇, q̈)/τ_max tied to the chain by the
 dynamics residual at each collocation point) and `PathTimingOCP` (x = s ∈ [0, 1] along a fixed path p(s), m = 1,
@@ -31,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.dynamics import Dynamics
-from ocpkit.path_spline import PathSpline
+from ocpkit.path_spline import DEGREE, PathSpline, symbolic
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot, rigid_torque
 from ocpkit.trajectory import Samples, Trajectory
@@ -73,7 +75,19 @@ class OCP(ABC):
     @property
     @abstractmethod
     def key(self) -> tuple:
-        """Hashable, equal exactly when two OCPs give the same NLP for the same transcription and robot."""
+        """Hashable, equal exactly when two OCPs give the same NLP for the same transcription and robot (their
+        parameter values may differ)."""
+
+    def parameter_shapes(self) -> dict[str, tuple[int, int]]:
+        """Name → (rows, columns) of each NLP parameter of the OCP; none by default."""
+        return {}
+
+    def parameter_values(self) -> dict[str, np.ndarray]:
+        """Name → value (shaped as declared) of each parameter."""
+        return {}
+
+    def use_parameters(self, symbols: dict[str, ca.SX]) -> None:
+        """Take the symbols of the declared parameters, by name, for the expressions built afterwards."""
 
     @property
     def width(self) -> int:
@@ -199,13 +213,26 @@ class PathTimingOCP(OCP):
     def __init__(self, robot: Robot, path: PathSpline) -> None:
         super().__init__(robot)
         self.path = path
+        self.symbols: tuple[ca.SX, ca.SX] = ()
 
     @property
     def key(self) -> tuple:
-        return "path-timing", self.path.key
+        """The number of the path's polynomial pieces: the path itself enters as parameters."""
+        return "path-timing", self.path.intervals
+
+    def parameter_shapes(self) -> dict[str, tuple[int, int]]:
+        """"breaks" and "coefficients" of the path (`PathSpline.parameters`)."""
+        K = self.path.intervals
+        return {"breaks": (K + 1, 1), "coefficients": ((DEGREE + 1) * self.robot.n, K)}
+
+    def parameter_values(self) -> dict[str, np.ndarray]:
+        return dict(zip(("breaks", "coefficients"), self.path.parameters()))
+
+    def use_parameters(self, symbols: dict[str, ca.SX]) -> None:
+        self.symbols = symbols["breaks"], symbols["coefficients"]
 
     def robot_state(self, x: Node) -> tuple[ca.SX, ca.SX, ca.SX]:
-        p, dp, ddp, _ = self.path.symbolic(x.q)
+        p, dp, ddp, _ = symbolic(x.q, *self.symbols)
         return p, dp * x.qd, dp * x.qdd + ddp * x.qd ** 2
 
 
@@ -217,13 +244,13 @@ class PathTimingOCP(OCP):
         """τ(s, ṡ, s̈) = dynamics.inverse(q, q̇, q̈) and its derivative along (ds/dσ, dṡ/dσ, ds̈/dσ), by AD."""
         chain, change = ca.SX.sym("chain", 3), ca.SX.sym("change", 3)
         tau = dynamics.inverse(*self.robot_state(Node(chain[0], chain[1], chain[2], None)))
-        function = ca.Function("path_torque", [chain, change], [tau, ca.jtimes(tau, chain, change)])
+        function = ca.Function("path_torque", [chain, change, *self.symbols], [tau, ca.jtimes(tau, chain, change)])
         return lambda x, slope, dt_ds: function(ca.vertcat(x.q, x.qd, x.qdd),
-                                                ca.vertcat(dt_ds * x.qd, dt_ds * x.qdd, slope.xdd))
+                                                ca.vertcat(dt_ds * x.qd, dt_ds * x.qdd, slope.xdd), *self.symbols)
 
     def jerk_s(self, x: Node, dxdd_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
         """p′ ds̈/dσ + (3p″ṡs̈ + p‴ṡ³) dt/dσ."""
-        _, dp, ddp, dddp = self.path.symbolic(x.q)
+        _, dp, ddp, dddp = symbolic(x.q, *self.symbols)
         return dp * dxdd_ds + (3 * ddp * x.qd * x.qdd + dddp * x.qd ** 3) * dt_ds
 
     def columns(self, chain: Samples) -> np.ndarray:
