@@ -111,7 +111,7 @@ def _bench_command(args: argparse.Namespace) -> int:
         from ocpkit.ladder import DEFAULT_LADDER, SINGLE_SHOT
 
         run_random(args.seed, args.count, _one_knot_count(args, "chebyshev"), obstacles=tuple(args.obstacles),
-                   out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER)
+                   out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER, planner=args.planner)
     elif args.suite == "solvers":
         from ocpkit.bench.solvers import run_solver_benchmark
 
@@ -251,6 +251,7 @@ def parser() -> argparse.ArgumentParser:
                    help="random: obstacles per problem, drawn from MIN..MAX (default 1 1)")
     b.add_argument("--single-shot", action="store_true", help="random: plan without the fallback ladder (the "
                    "paper's one solve; bench paper always plans so)")
+    b.add_argument("--planner", default="simultaneous", help="random: the planner (default simultaneous)")
     b.set_defaults(run=_bench_command)
     ls = commands.add_parser("list", help="list the registered components (transcriptions, dynamics, constraints, "
                              "solvers, planners, guesses) with one line each")
