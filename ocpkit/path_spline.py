@@ -1,7 +1,11 @@
 """A fixed joint-space path q = p(s), s ∈ [0, 1], smooth to its third derivative, in NumPy and in CasADi.
 
-`PathSpline.fit` interpolates waypoints by a quintic spline (C⁴: p‴ is continuous) in the chord length c (rad),
-with p′ = p″ = 0 at both ends. Its normalised parameter is s = c / L (L the chord length of the whole path).
+`PathSpline.fit` interpolates waypoints by the natural quintic spline (C⁴: p‴ is continuous) in the chord length
+c (rad): p‴ = p⁗ = 0 at both ends, which makes it the interpolant of least ∫|p‴|² dc. Its normalised parameter
+is s = c / L (L the chord length of the whole path). Rest at both ends is the timing's (ṡ = s̈ = 0 gives
+q̇ = q̈ = 0), so the path keeps its tangent there: with p′ = 0 at the ends (a clamped spline, what TOPP-RA needs)
+the path speed would vanish in s and the timing OCP would need ṡ → ∞ near the ends, which its polynomials
+represent badly (README, "ompl-topp3").
 Both evaluations use one piecewise polynomial in s (the spline's own Taylor coefficients at every breakpoint):
 `values` in NumPy, `symbolic` on CasADi symbols for s, the breakpoints and the coefficients (the interval
 selected by comparisons, so the expression is exact wherever s is; the breakpoints and coefficients are NLP
@@ -31,12 +35,12 @@ class PathSpline:
 
     @classmethod
     def fit(cls, chord: np.ndarray, waypoints: np.ndarray) -> PathSpline:
-        """The quintic through `waypoints` (k, n) at increasing chord lengths `chord` (k,), rad, at rest at both
-        ends (p′ = p″ = 0)."""
+        """The natural quintic through `waypoints` (k, n) at increasing chord lengths `chord` (k,), rad
+        (p‴ = p⁗ = 0 at both ends)."""
         length = float(chord[-1])
         s = chord / length
         zero = np.zeros(waypoints.shape[1])
-        ends = [(1, zero), (2, zero)]
+        ends = [(3, zero), (4, zero)]
         curve = make_interp_spline(s, waypoints, k=DEGREE, bc_type=(ends, ends))
         breaks = np.unique(np.clip(curve.t, 0.0, 1.0))
         coefficients = np.stack([curve(breaks[:-1], nu=j) / factorial(j) for j in range(DEGREE + 1)], axis=1)

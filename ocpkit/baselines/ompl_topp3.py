@@ -2,8 +2,8 @@
 
 1. The OMPL path exactly as `ompl-toppra` finds it (ompl_toppra.py: same validity checker, planner, seed and
    shortcutting).
-2. Made smooth to its third derivative: a quintic spline in the chord length (`PathSpline`, p′ = p″ = 0 at both
-   ends), re-checked densely and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4
+2. Made smooth to its third derivative: the natural quintic spline in the chord length (`PathSpline`), re-checked
+   densely and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4
    rad). Its parameter is normalised: q = p(s), s ∈ [0, 1].
 3. The timing along that fixed path as an optimal control problem in s (`PathTimingOCP`): s(t) from rest at 0 to
    rest at 1, q̇ = p′ṡ, q̈ = p′s̈ + p″ṡ², q⃛ = p′s⃛ + 3p″ṡs̈ + p‴ṡ³, τ = RNEA(q, q̇, q̈) + friction; the
