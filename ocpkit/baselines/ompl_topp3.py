@@ -3,7 +3,7 @@
 1. The OMPL path exactly as `ompl-toppra` finds it (ompl_toppra.py: same validity checker, planner, seed and
    shortcutting).
 2. Made smooth to its third derivative: the natural quintic spline in the chord length (`PathSpline`), re-checked
-   densely and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4
+   densely for collision and for the joint position limits (which the timing cannot change) and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4
    rad). Its parameter is normalised: q = p(s), s ∈ [0, 1].
 3. The timing along that fixed path as an optimal control problem in s (`PathTimingOCP`): s(t) from rest at 0 to
    rest at 1, q̇ = p′ṡ, q̈ = p′s̈ + p″ṡ², q⃛ = p′s⃛ + 3p″ṡs̈ + p‴ṡ³, τ = RNEA(q, q̇, q̈) + friction; the
@@ -106,7 +106,7 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     if found.waypoints is None:
         return finish(problem, _hold(problem), "no_path", method, began, setup_time=setup, extra=extra, found=False,
                       message=f"{planner_name}: no exact path within {planning_time:g} s; the plan holds the start")
-    smooth, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit)
+    smooth, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
     path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
     timed = _time_optimal(problem, ToppraPath(path), grid_points)
     extra.update(waypoints=len(found.waypoints), repair_rounds=rounds, toppra_tf_s=np.nan)

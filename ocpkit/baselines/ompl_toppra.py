@@ -221,10 +221,11 @@ def _clamped_cubic(chord: np.ndarray, waypoints: np.ndarray) -> Any:
 
 
 def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float,
-                 fit: Callable[[np.ndarray, np.ndarray], Any] = _clamped_cubic) -> tuple[Any, int]:
+                 fit: Callable[[np.ndarray, np.ndarray], Any] = _clamped_cubic,
+                 within_limits: bool = False) -> tuple[Any, int]:
     """A spline `fit(chord, waypoints)` (a clamped cubic by default) through `waypoints` (k, n), parametrised by
-    chord length (rad), that keeps half the margin at checks every resolution/4 rad (the spline called with chord
-    lengths); returns (the spline, repair rounds used).
+    chord length (rad), that keeps half the margin (and, `within_limits`, the joint position limits) at checks
+    every resolution/4 rad (the spline called with chord lengths); returns (the spline, repair rounds used).
 
     After the last round the spline is returned as it is; `verify` then reports any contact."""
     waypoints = waypoints[np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 0])]
@@ -232,7 +233,9 @@ def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float,
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
         path = fit(chord, waypoints)
         checks = np.linspace(0.0, chord[-1], int(np.ceil(4 * chord[-1] / resolution)) + 1)
-        bad = checks[free.clearance(path(checks)) < free.margin / 2]
+        q = path(checks)
+        outside = ((q < free.robot.q_lower) | (q > free.robot.q_upper)).any(axis=1) if within_limits else False
+        bad = checks[(free.clearance(q) < free.margin / 2) | outside]
         if not len(bad) or rounds == REPAIR_ROUNDS:
             break
         segments = np.unique(np.clip(np.searchsorted(chord, bad) - 1, 0, len(chord) - 2))

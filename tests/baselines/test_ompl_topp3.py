@@ -206,3 +206,14 @@ def test_every_paper_case_verifies_and_passes_the_outside_check(case, tmp_path):
     plan = ocpkit.plan(ocpkit.load_scenario(scenario), planner="ompl-topp3")
     assert plan.status == "verified", plan.verification.summary()
     outside_check(plan, scenario, tmp_path)
+
+
+def test_a_path_that_leaves_the_joint_limits_is_repaired():
+    """Random problem 7 (seed 1): the natural quintic through its OMPL waypoints leaves joint 2's position limit,
+    which no timing can fix; the smoothing repairs it (a waypoint inserted) and the plan verifies."""
+    from ocpkit.bench.random import random_problems
+
+    problem = next(p for p in random_problems(1, 30) if p.name == "random7")
+    plan = ocpkit.plan(problem, planner="ompl-topp3")
+    assert plan.stats.extra["repair_rounds"] >= 1
+    assert plan.status == "verified", plan.verification.summary()
