@@ -209,7 +209,7 @@ def test_every_paper_case_verifies_and_passes_the_outside_check(case, tmp_path):
 
 
 def test_a_path_that_leaves_the_joint_limits_is_repaired():
-    """Random problem 7 (seed 1): the natural quintic through its OMPL waypoints leaves joint 2's position limit,
+    """Random problem 7 (seed 1): the natural quintic through its OMPL waypoints leaves a joint's position limit,
     which no timing can fix; the smoothing repairs it (a waypoint inserted) and the plan verifies."""
     from ocpkit.bench.random import random_problems
 
