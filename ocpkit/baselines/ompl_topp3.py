@@ -3,8 +3,8 @@
 1. The OMPL path exactly as `ompl-toppra` finds it (ompl_toppra.py: same validity checker, planner, seed and
    shortcutting).
 2. Made smooth to its third derivative: the natural quintic spline in the chord length (`PathSpline`), re-checked
-   densely for collision and for the joint position limits (which the timing cannot change) and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4
-   rad). Its parameter is normalised: q = p(s), s ∈ [0, 1].
+   densely and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4 rad, and the joint
+   position limits, which the timing cannot change). Its parameter is normalised: q = p(s), s ∈ [0, 1].
 3. The timing along that fixed path as an optimal control problem in s (`PathTimingOCP`): s(t) from rest at 0 to
    rest at 1, q̇ = p′ṡ, q̈ = p′s̈ + p″ṡ², q⃛ = p′s⃛ + 3p″ṡs̈ + p‴ṡ³, τ = RNEA(q, q̇, q̈) + friction; the
    velocity, torque and torque-rate limits and the cost t_f + μ∫q⃛ᵀQq⃛ dt of the simultaneous planner. It is

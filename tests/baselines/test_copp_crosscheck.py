@@ -76,4 +76,4 @@ def test_ompl_topp3_timing_agrees_with_copp_topp3_on_a_paper_path():
     plan = ocpkit.plan(problem, planner="ompl-topp3", transcription="trapezoidal", knots=80)
     assert plan.status == "verified", plan.verification.summary()
     reference = copp_topp3(problem, plan.trajectory.interpolant.ocp.path)
-    assert plan.trajectory.tf == pytest.approx(reference, rel=0.06)
+    assert plan.trajectory.tf == pytest.approx(reference, rel=0.01)
