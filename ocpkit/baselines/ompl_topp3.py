@@ -10,7 +10,8 @@
    velocity, torque and torque-rate limits and the cost t_f + μ∫q⃛ᵀQq⃛ dt of the simultaneous planner. It is
    transcribed and solved by ocpkit's own transcriptions and solvers (the same arguments as
    `plan_simultaneous`: transcription, knots, dynamics, solver, ...), solved with the same refinement rounds,
-   warm-started from the TOPP-RA profile of the same path (`_time_optimal`). The path enters the NLP as
+   warm-started from the TOPP-RA profile of the same path (`_time_optimal`; where TOPP-RA cannot time it, from
+   s moving at constant speed over time.guess, `PathTimingOCP.guess`). The path enters the NLP as
    parameters, its pieces split up to a multiple of PIECES_STEP, so paths share one build (the build cache's,
    like the simultaneous planner's shapes) and its one-time set-up is not computation.
    Collision is not a constraint of the timing: the path is fixed and was checked; `verify` checks it again.
@@ -26,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ocpkit.baselines.ompl_toppra import (_hold, _import_backends, _ompl_path, _smooth_path, _time_optimal,
-                                         planning_space)
+                                         check_ompl_planner, planning_space)
 from ocpkit.build_cache import build
 from ocpkit.dynamics import Dynamics
 from ocpkit.path_spline import PathSpline
@@ -93,7 +94,8 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     (`planner_name`, `planning_time`, `seed`, `resolution`, `margin`; `grid_points` for the TOPP-RA warm start).
 
     Status: the solver's when it did not converge, else "verified" or "violated"; "no_path" (OMPL found no exact
-    path) or "infeasible" (TOPP-RA cannot time the path within the limits, so no warm start) hold the start."""
+    path) holds the start."""
+    check_ompl_planner(planner_name)
     began = time.perf_counter()
     method = {"planner": "ompl-topp3", "path_planner": planner_name, "transcription": transcription, "knots": knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": solver}
@@ -110,21 +112,20 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
     timed = _time_optimal(problem, ToppraPath(path), grid_points)
     extra.update(waypoints=len(found.waypoints), repair_rounds=rounds, toppra_tf_s=np.nan)
-    if timed is None:
-        return finish(problem, _hold(problem), "infeasible", method, began, setup_time=setup, extra=extra,
-                      found=False, message="TOPP-RA cannot time the smoothed path: no warm start; the plan holds "
-                      "the start")
-    extra["toppra_tf_s"] = float(timed[1][-1])
     ocp = PathTimingOCP(problem.robot, path)
     made = build(problem, transcription, knots, dynamics, solver, TIMING_CONSTRAINTS, transcription_options,
                  solver_options, dynamics_options, ocp=ocp)
     discretization = made.discretization.with_ocp(ocp)
-    w = discretization.encode(toppra_profile(timed[0]))
+    if timed is None:
+        w, start = discretization.initial_guess(problem), "from s at constant speed (no TOPP-RA profile)"
+    else:
+        w, start = discretization.encode(toppra_profile(timed[0])), "from TOPP-RA's profile"
+        extra["toppra_tf_s"] = float(timed[1][-1])
     refined = solve_refined(discretization, made.solver, problem, w, refinements,
                             time.perf_counter() + max_wall_time)
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
-    message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; timing: "
+    message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; timing {start}: "
                f"{result.message}")
     return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + made.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=message, extra=extra,

@@ -110,6 +110,12 @@ def _coarse_to_fine(count: int) -> np.ndarray:
     return np.concatenate([[count], inner[np.argsort(-(inner & -inner), kind="stable")]])
 
 
+def check_ompl_planner(planner_name: str) -> None:
+    """RegistryError unless `planner_name` is one of OMPL_PLANNERS."""
+    if planner_name not in OMPL_PLANNERS:
+        raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
+
+
 def planning_space(problem: Problem, margin: float) -> FreeSpace:
     """The FreeSpace OMPL plans in: `margin` (m), lowered to the start's or goal's clearance if that is smaller."""
     ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
@@ -344,8 +350,7 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start (`Plan.found`
     False). When the goal is the start, the path has length zero: the plan is to hold still at the start for
     time.min seconds, verified like any other motion, without calling OMPL or TOPP-RA."""
-    if planner_name not in OMPL_PLANNERS:
-        raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
+    check_ompl_planner(planner_name)
     began = time.perf_counter()
     method = {"planner": "ompl-toppra", "path_planner": planner_name, "grid_points": grid_points}
     if np.array_equal(problem.start, problem.goal):

@@ -217,3 +217,24 @@ def test_a_path_that_leaves_the_joint_limits_is_repaired():
     plan = ocpkit.plan(problem, planner="ompl-topp3")
     assert plan.stats.extra["repair_rounds"] >= 1
     assert plan.status == "verified", plan.verification.summary()
+
+
+def test_without_a_toppra_profile_the_timing_starts_from_constant_speed(monkeypatch):
+    import ocpkit.baselines.ompl_topp3 as topp3
+
+    monkeypatch.setattr(topp3, "_time_optimal", lambda *args: None)
+    plan = ocpkit.plan(ocpkit.load_scenario(REPO / "scenarios/paper/case4.yaml"), planner="ompl-topp3")
+    assert "from s at constant speed" in plan.stats.solver_message
+    assert plan.status == "verified", plan.verification.summary()
+
+
+def test_an_unknown_ompl_planner_is_named_before_planning():
+    with pytest.raises(ocpkit.errors.RegistryError, match="unknown OMPL planner 'rrt-fast'"):
+        ocpkit.plan(CASE1, planner="ompl-topp3", planner_name="rrt-fast")
+
+
+def test_the_goal_at_the_start_holds_still():
+    import dataclasses
+
+    plan = ocpkit.plan(dataclasses.replace(CASE1, goal=CASE1.start), planner="ompl-topp3")
+    assert plan.status == "verified" and plan.trajectory.tf == CASE1.time.min
