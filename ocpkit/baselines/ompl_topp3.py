@@ -22,7 +22,7 @@ The motion returned is q(t) = p(s(t)) at every sample, so it stays on the checke
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -33,7 +33,7 @@ from ocpkit.dynamics import Dynamics
 from ocpkit.path_spline import PathSpline
 from ocpkit.plan import Plan, finish
 from ocpkit.problem import Problem
-from ocpkit.refine import DEFAULT_ROUNDS, solve_refined
+from ocpkit.refine import DEFAULT_ROUNDS, Refined, solve_refined
 from ocpkit.solvers import SolverStatus
 from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription.ocp import PathTimingOCP
@@ -81,6 +81,40 @@ def toppra_profile(motion: Any) -> Trajectory:
     return Trajectory(profile(times), profile)
 
 
+class TimedPath(NamedTuple):
+    """The timing of one path: the refined solve, the set-up of its build (s), how it started, TOPP-RA's t_f (s;
+    NaN without a TOPP-RA profile)."""
+
+    refined: Refined
+    setup_time: float
+    start: str
+    toppra_tf: float
+
+
+def time_path(problem: Problem, smooth: PathSpline, transcription: str = "chebyshev", knots: int = 12,
+              dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt", refinements: int = DEFAULT_ROUNDS,
+              transcription_options: dict | None = None, solver_options: dict | None = None,
+              dynamics_options: dict | None = None, max_wall_time: float = 60.0, grid_points: int = 1000
+              ) -> TimedPath:
+    """The optimal timing of the fixed path `smooth` (from problem.start to problem.goal) under `problem`'s limits
+    and cost (the module docstring's step 3; options as for `plan_ompl_topp3`)."""
+    path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
+    timed = _time_optimal(problem, ToppraPath(path), grid_points)
+    ocp = PathTimingOCP(problem.robot, path)
+    made = build(problem, transcription, knots, dynamics, solver, TIMING_CONSTRAINTS, transcription_options,
+                 solver_options, dynamics_options, ocp=ocp)
+    discretization = made.discretization.with_ocp(ocp)
+    if timed is None:
+        w, start, toppra_tf = discretization.initial_guess(problem), "from s at constant speed (no TOPP-RA profile)", \
+            np.nan
+    else:
+        w, start, toppra_tf = discretization.encode(toppra_profile(timed[0])), "from TOPP-RA's profile", \
+            float(timed[1][-1])
+    refined = solve_refined(discretization, made.solver, problem, w, refinements,
+                            time.perf_counter() + max_wall_time)
+    return TimedPath(refined, made.setup_time, start, toppra_tf)
+
+
 def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
                     dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt",
                     refinements: int = DEFAULT_ROUNDS, transcription_options: dict | None = None,
@@ -109,24 +143,13 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
         return finish(problem, _hold(problem), "no_path", method, began, setup_time=setup, extra=extra, found=False,
                       message=f"{planner_name}: no exact path within {planning_time:g} s; the plan holds the start")
     smooth, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
-    path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
-    timed = _time_optimal(problem, ToppraPath(path), grid_points)
-    extra.update(waypoints=len(found.waypoints), repair_rounds=rounds, toppra_tf_s=np.nan)
-    ocp = PathTimingOCP(problem.robot, path)
-    made = build(problem, transcription, knots, dynamics, solver, TIMING_CONSTRAINTS, transcription_options,
-                 solver_options, dynamics_options, ocp=ocp)
-    discretization = made.discretization.with_ocp(ocp)
-    if timed is None:
-        w, start = discretization.initial_guess(problem), "from s at constant speed (no TOPP-RA profile)"
-    else:
-        w, start = discretization.encode(toppra_profile(timed[0])), "from TOPP-RA's profile"
-        extra["toppra_tf_s"] = float(timed[1][-1])
-    refined = solve_refined(discretization, made.solver, problem, w, refinements,
-                            time.perf_counter() + max_wall_time)
-    result = refined.result
+    timing = time_path(problem, smooth, transcription, knots, dynamics, solver, refinements, transcription_options,
+                       solver_options, dynamics_options, max_wall_time, grid_points)
+    refined, result = timing.refined, timing.refined.result
+    extra.update(waypoints=len(found.waypoints), repair_rounds=rounds, toppra_tf_s=timing.toppra_tf)
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
-    message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; timing {start}: "
+    message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; timing {timing.start}: "
                f"{result.message}")
-    return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + made.setup_time,
+    return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + timing.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=message, extra=extra,
                   verification=refined.verification)

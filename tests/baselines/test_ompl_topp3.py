@@ -238,3 +238,20 @@ def test_the_goal_at_the_start_holds_still():
 
     plan = ocpkit.plan(dataclasses.replace(CASE1, goal=CASE1.start), planner="ompl-topp3")
     assert plan.status == "verified" and plan.trajectory.tf == CASE1.time.min
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["case1", "case2"])
+def test_retiming_the_simultaneous_plans_own_path_reproduces_its_motion_time(case):
+    """Two OCP families, one answer: the simultaneous plan's path (a natural quintic through 25 of its samples),
+    timed by the path-timing OCP with the same limits and cost, takes the simultaneous plan's t_f within 1 %."""
+    from ocpkit.baselines.ompl_topp3 import time_path
+    from ocpkit.ladder import SINGLE_SHOT
+
+    problem = ocpkit.load_scenario(REPO / f"scenarios/paper/{case}.yaml")
+    simultaneous = ocpkit.plan(problem, fallbacks=SINGLE_SHOT)
+    q = simultaneous.trajectory.interpolant(np.linspace(0, simultaneous.trajectory.tf, 25)).q
+    chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))])
+    timed = time_path(problem, PathSpline.fit(chord, q)).refined
+    assert timed.verification.ok, timed.verification.summary()
+    assert timed.trajectory.tf == pytest.approx(simultaneous.trajectory.tf, rel=0.01)
