@@ -21,6 +21,7 @@ from ocpkit.errors import OptionError
 from ocpkit.problem import Problem
 from ocpkit.solvers import SOLVERS, PreparedSolver
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
+from ocpkit.transcription.ocp import OCP
 
 CACHE_SIZE = 32
 
@@ -41,21 +42,22 @@ _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
 def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str | Dynamics = "casadi-rnea",
           solver: str = "ipopt", constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
           transcription_options: dict | None = None, solver_options: dict | None = None,
-          dynamics_options: dict | None = None) -> Build:
+          dynamics_options: dict | None = None, ocp: OCP | None = None) -> Build:
     """The build for `problem`'s shape (module docstring): components by registered name (`ocpkit list`), a
-    dynamics backend also as an instance; unknown options raise OptionError."""
+    dynamics backend also as an instance; unknown options raise OptionError. `ocp` is the OCP to discretize:
+    the robot OCP of `problem` by default (ocpkit.transcription.ocp)."""
     method = construct(TRANSCRIPTIONS.get(transcription), transcription, {"knots": knots,
                                                                           **(transcription_options or {})})
     backend = make_dynamics(dynamics, problem.robot, **(dynamics_options or {}))
     plugins = make_constraints(problem, constraints)
     options = solver_options or {}
     nlp_solver = construct(SOLVERS.get(solver), solver, options)  # a wrong name or option fails before a build
-    key = (method.shape_key(backend, plugins), solver, frozen(options))
+    key = (method.shape_key(backend, plugins, ocp), solver, frozen(options))
     if key in _BUILDS:
         _BUILDS.move_to_end(key)
         return Build(_BUILDS[key].discretization, _BUILDS[key].solver, 0.0)
     began = time.perf_counter()
-    discretization = method.build(problem, backend, plugins)
+    discretization = method.build(problem, backend, plugins, ocp)
     prepared = nlp_solver.prepare(discretization.nlp)
     _BUILDS[key] = Build(discretization, prepared, time.perf_counter() - began)
     while len(_BUILDS) > CACHE_SIZE:

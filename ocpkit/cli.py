@@ -117,7 +117,7 @@ def _bench_command(args: argparse.Namespace) -> int:
         from ocpkit.ladder import DEFAULT_LADDER, SINGLE_SHOT
 
         run_random(args.seed, args.count, _one_knot_count(args, "chebyshev"), obstacles=tuple(args.obstacles),
-                   out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER)
+                   out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER, planner=args.planner)
     elif args.suite == "shapes":
         from ocpkit.bench.shapes import run_shapes_benchmark
 
@@ -266,6 +266,7 @@ def parser() -> argparse.ArgumentParser:
                    help="random: obstacles per problem, drawn from MIN..MAX (default 1 1)")
     b.add_argument("--single-shot", action="store_true", help="random: plan without the fallback ladder (the "
                    "paper's one solve; bench paper always plans so)")
+    b.add_argument("--planner", default="simultaneous", help="random: the planner (default simultaneous)")
     add_run_arguments(b)
     b.set_defaults(run=_bench_command)
     add_report_parser(commands)

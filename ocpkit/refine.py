@@ -32,7 +32,7 @@ MIN_MARGIN_STEP = 0.005  # m
 PENETRATION_FACTOR = 2.0
 LIMIT_BACKOFF = 0.005  # fraction of each limit
 MIN_SHRINK = 0.5  # one round never takes more than half of a limit away
-NAMED_PARTS = ("tf", "q", "qd", "qdd", "u")  # parts of w an out-of-bounds message names (Discretization)
+NAMED_PARTS = ("tf", "q", "qd", "qdd", "u", "s", "sd", "sdd")  # parts of w named in out-of-bounds messages
 
 
 @dataclass(frozen=True)

@@ -40,7 +40,7 @@ def row_key(row: dict, columns: tuple[str, ...] = KEY_COLUMNS) -> tuple[str, ...
 @dataclass(frozen=True)
 class Recorded:
     """A results row's figures as numbers: status, t_f (s), computation and set-up time (s), iterations, the
-    verification summary and the planner's own figures."""
+    verification summary, the planner's own figures and the largest violation (`max_violation`)."""
 
     status: str
     tf: float
@@ -49,6 +49,7 @@ class Recorded:
     iterations: int
     checks: str
     extra: dict
+    max_violation: float = 0.0
 
     @property
     def ok(self) -> bool:
@@ -58,7 +59,7 @@ class Recorded:
     def of(cls, row: dict) -> Recorded:
         """The figures of `row`, fresh from `result_row` or read back from results.csv."""
         return cls(row["status"], float(row["tf"]), float(row["solve_time_s"]), float(row["setup_time_s"]),
-                   int(row["iterations"]), row["checks"], json.loads(row["extra"]))
+                   int(row["iterations"]), row["checks"], json.loads(row["extra"]), float(row["max_violation"]))
 
 
 def max_violation(plan: Plan) -> float:

@@ -45,7 +45,7 @@ OMPL and toppra are optional dependencies, imported on first use (toppra is slow
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
@@ -104,16 +104,22 @@ class FreeSpace:
         return True
 
 
-def _free_space(problem: Problem, margin: float) -> FreeSpace:
-    """The free space of `problem` with `margin` (m), lowered to the start's or goal's clearance if that is smaller."""
-    ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
-    return FreeSpace(problem, min(margin, float(ends.min())))
-
-
 def _coarse_to_fine(count: int) -> np.ndarray:
     """The indices 1..count: count first, then the others by decreasing power of two dividing them."""
     inner = np.arange(1, count)
     return np.concatenate([[count], inner[np.argsort(-(inner & -inner), kind="stable")]])
+
+
+def check_ompl_planner(planner_name: str) -> None:
+    """RegistryError unless `planner_name` is one of OMPL_PLANNERS."""
+    if planner_name not in OMPL_PLANNERS:
+        raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
+
+
+def planning_space(problem: Problem, margin: float) -> FreeSpace:
+    """The FreeSpace OMPL plans in: `margin` (m), lowered to the start's or goal's clearance if that is smaller."""
+    ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
+    return FreeSpace(problem, min(margin, float(ends.min())))
 
 
 # -- OMPL ---------------------------------------------------------------------------------------------
@@ -229,19 +235,29 @@ def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_ti
 # -- smooth path --------------------------------------------------------------------------------------
 
 
-def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float) -> tuple[Any, int]:
-    """A clamped cubic spline through `waypoints` (k, n), parametrised by chord length (rad), that keeps half
-    the margin at checks every resolution/4 rad; returns (toppra path, repair rounds used).
-
-    After the last round the spline is returned as it is; `verify` then reports any contact."""
+def _clamped_cubic(chord: np.ndarray, waypoints: np.ndarray) -> Any:
+    """toppra's clamped cubic spline through `waypoints` (k, n) at chord lengths `chord` (k,), rad."""
     from toppra.interpolator import SplineInterpolator
 
+    return SplineInterpolator(chord, waypoints, bc_type="clamped")
+
+
+def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float,
+                 fit: Callable[[np.ndarray, np.ndarray], Any] = _clamped_cubic,
+                 within_limits: bool = False) -> tuple[Any, int]:
+    """A spline `fit(chord, waypoints)` (a clamped cubic by default) through `waypoints` (k, n), parametrised by
+    chord length (rad), that keeps half the margin (and, `within_limits`, the joint position limits) at checks
+    every resolution/4 rad (the spline called with chord lengths); returns (the spline, repair rounds used).
+
+    After the last round the spline is returned as it is; `verify` then reports any contact."""
     waypoints = waypoints[np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 0])]
     for rounds in range(REPAIR_ROUNDS + 1):
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
-        path = SplineInterpolator(chord, waypoints, bc_type="clamped")
+        path = fit(chord, waypoints)
         checks = np.linspace(0.0, chord[-1], int(np.ceil(4 * chord[-1] / resolution)) + 1)
-        bad = checks[free.clearance(path(checks)) < free.margin / 2]
+        q = path(checks)
+        outside = ((q < free.robot.q_lower) | (q > free.robot.q_upper)).any(axis=1) if within_limits else False
+        bad = checks[(free.clearance(q) < free.margin / 2) | outside]
         if not len(bad) or rounds == REPAIR_ROUNDS:
             break
         segments = np.unique(np.clip(np.searchsorted(chord, bad) - 1, 0, len(chord) - 2))
@@ -353,14 +369,13 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start (`Plan.found`
     False). When the goal is the start, the path has length zero: the plan is to hold still at the start for
     time.min seconds, verified like any other motion, without calling OMPL or TOPP-RA."""
-    if planner_name not in OMPL_PLANNERS:
-        raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
+    check_ompl_planner(planner_name)
     began = time.perf_counter()
     method = {"planner": "ompl-toppra", "path_planner": planner_name, "grid_points": grid_points}
     if np.array_equal(problem.start, problem.goal):
         return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
     setup = _import_backends()
-    free = _free_space(problem, margin)
+    free = planning_space(problem, margin)
     found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks)
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
              "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,
@@ -394,7 +409,7 @@ def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time
     """The baseline's simplified collision-free joint-space path (waypoints (k, n), rad) from start to goal, or None
     if the OMPL planner found none within `planning_time` s and `max_checks` configurations checked (options as for
     `plan_ompl_toppra`)."""
-    free = _free_space(problem, margin)
+    free = planning_space(problem, margin)
     return _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks).waypoints
 
 

@@ -1,6 +1,8 @@
 """The paper's experiment (Table II): four pick-and-place cases at 12 and 8 knots, μ = 0.3, against the
-path–velocity decomposition baseline (OMPL + TOPP-RA), plus hybrid seeding of the simultaneous planner. The
-simultaneous planner runs single shot (`fallbacks=SINGLE_SHOT`), the paper's setting, not the default ladder.
+path–velocity decomposition baselines: OMPL + TOPP-RA (which cannot bound torque rate) and OMPL + the path-timing
+OCP (`ompl-topp3`: the same limits and cost, solved at the simultaneous planner's first knot count, transcription
+and dynamics), plus hybrid seeding of the simultaneous planner. The simultaneous planner runs single shot
+(`fallbacks=SINGLE_SHOT`), the paper's setting, not the default ladder.
 
 Computation time is the wall time of one plan whose NLP shape is already built (all refinement rounds
 and the dense verification included), median over `repeats` runs; set-up is the first build of a shape.
@@ -55,6 +57,7 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
         simultaneous = {(form, p.name, n): bench.simultaneous("paper", p, n, form, write=form == dynamics[0])
                         for form in dynamics for n in knots for p in problems}
         baseline = {p.name: bench.baseline(p) for p in problems}
+        topp3 = {p.name: bench.topp3(p, knots[0], dynamics[0]) for p in problems}
         matched = {p.name: bench.simultaneous("matched-to-baseline", p, knots[0], dynamics[0], repeats=1)
                    for p in _matched_to_baseline(problems)}
         seeding = bench.seeding(problems + load_all(Path(hard)), knots[0], dynamics[0]) if hard is not None else {}
@@ -63,6 +66,7 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
     print(_paper_table(problems, first, f"{transcription}{options} + ipopt, dynamics {dynamics[0]}", knots))
     print(_comparison(problems, simultaneous, dynamics, knots))
     print(_baseline_table(problems, {c: m for (c, k), m in first.items() if k == knots[0]}, baseline, matched))
+    print(_same_limits_table(problems, {c: m for (c, k), m in first.items() if k == knots[0]}, baseline, topp3))
     if hard is not None:
         print(_seeding_table(seeding))
     print(f"{machine()}; computation times are medians of {repeats} runs per plan (seeding: 1 run)")
@@ -98,6 +102,15 @@ class _Bench:
     def baseline(self, problem: Problem) -> Recorded:
         """The OMPL + TOPP-RA baseline's row for `problem`."""
         return self._row("paper", problem, {"planner": "ompl-toppra"}, True, self.repeats, planner="ompl-toppra")
+
+    def topp3(self, problem: Problem, knots: int, dynamics: str) -> Recorded:
+        """The ompl-topp3 baseline's row for `problem`: its timing OCP transcribed as the simultaneous planner's
+        problem is (transcription and its options, `knots`, `dynamics`, ipopt)."""
+        method = {"planner": "ompl-topp3", "transcription": self.transcription, "knots": knots, "solver": "ipopt",
+                  "dynamics": dynamics}
+        return self._row("paper", problem, method, True, self.repeats, planner="ompl-topp3",
+                         transcription=self.transcription, transcription_options=self.options, knots=knots,
+                         dynamics=dynamics)
 
     def _row(self, suite: str, problem: Problem, method: dict, write: bool, repeats: int, **options) -> Recorded:
         def measured() -> dict:
@@ -187,6 +200,28 @@ def _baseline_table(problems: list[Problem], simultaneous: dict, baseline: dict,
         lines.append(f"  {p.name} baseline checks: {baseline[p.name].checks}")
     lines.append("  matched: the simultaneous planner given only what TOPP-RA enforces (torque-rate limits x1000, "
                  "mu = 0.001), verified against those relaxed limits")
+    return "\n".join(lines)
+
+
+def _same_limits_table(problems: list[Problem], simultaneous: dict, toppra: dict, topp3: dict) -> str:
+    """Per case: ompl-toppra (t_f, status, largest violation), ompl-topp3 (t_f, status, computation), the
+    simultaneous planner (t_f, computation) and t_f(simultaneous) / t_f(ompl-topp3)."""
+    head = f"{'':<30}" + "".join(f"{p.name:>{WIDTH}}" for p in problems)
+    lines = ["", "Decomposition held to the same limits and cost (ompl-topp3: the same OMPL path, quintic, timing OCP "
+             "with torque-rate limits and the jerk cost)", head, "-" * len(head)]
+    cells = {
+        "ompl-toppra t_f [s]": [f"{toppra[p.name].tf:.3f}" for p in problems],
+        "ompl-toppra status": [toppra[p.name].status for p in problems],
+        "ompl-toppra violation": [f"{toppra[p.name].max_violation:.3g}" for p in problems],
+        "ompl-topp3 t_f [s]": [f"{topp3[p.name].tf:.3f}" for p in problems],
+        "ompl-topp3 status": [topp3[p.name].status for p in problems],
+        "ompl-topp3 computation [s]": [f"{topp3[p.name].solve_time:.3f}" for p in problems],
+        "simultaneous t_f [s]": [f"{simultaneous[p.name].tf:.3f}" for p in problems],
+        "simultaneous computation [s]": [f"{simultaneous[p.name].solve_time:.3f}" for p in problems],
+        "ratio sim / ompl-topp3": [f"{simultaneous[p.name].tf / topp3[p.name].tf:.3f}" for p in problems],
+    }
+    lines += [f"{label:<30}" + "".join(f"{c:>{WIDTH}}" for c in row) for label, row in cells.items()]
+    lines.append("  violation: the largest excess over a limit (relative; the torque rate for ompl-toppra)")
     return "\n".join(lines)
 
 

@@ -97,14 +97,17 @@ def _near(rng: np.random.Generator, robot: Robot, start: np.ndarray, goal: np.nd
 
 
 def run_random(seed: int = 1, count: int = 30, knots: int = 12, obstacles: tuple[int, int] = (1, 1),
-               out: Path | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER) -> Counter:
+               out: Path | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER,
+               planner: str = "simultaneous") -> Counter:
     """Plan `count` random problems of `seed` (with `obstacles` spheres) with the simultaneous planner's defaults
     at `knots` and the ladder `fallbacks` (SINGLE_SHOT: the paper's one solve); print a line per problem, the
     summary and which rung verified how many; with `out`, write results.csv, the trajectories and the scenarios
-    there. Returns the status counts."""
+    there. Returns the status counts. Another `planner` (e.g. "ompl-topp3") plans them with its defaults instead
+    (`knots` and `fallbacks` are the simultaneous planner's)."""
     statuses, rungs, verified_times, rows = Counter(), Counter(), [], []
     for problem in random_problems(seed, count, obstacles):
-        result = plan(problem, knots=knots, fallbacks=fallbacks)
+        own = {"knots": knots, "fallbacks": fallbacks} if planner == "simultaneous" else {}
+        result = plan(problem, planner, **own)
         statuses[result.status] += 1
         if result.ok:
             verified_times.append(result.stats.solve_time)

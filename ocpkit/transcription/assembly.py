@@ -1,24 +1,25 @@
 """What every transcription's NLP shares, so each transcription module holds only its own math.
 
 A transcription creates its variables through `Assembly.w` (a Layout: the order of creation is the order in
-w) and adds its rows in the order it wants them; the assembly supplies the rest the same way for all:
+w) and adds its rows in the order it wants them; the assembly supplies the rest the same way for all, written
+against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP unless told otherwise):
 
-- the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, ...];
-- the values at a point, `point(node, du_ds, dt_ds)`: joint torque τ = τ_max ∘ u + friction(q̇) and its rate
-  dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈, where dt/ds is the transcription's (t_f/(2K) on a
-  pseudospectral segment, h = t_f/N on a mesh interval), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f
-  never divides;
+- the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, the OCP's, ...];
+- the nodes [x, ẋ, ẍ, u] (the OCP's chain and the scaled rigid-body torque u);
+- the values at a point, `point(node, slope, dt_ds)`: the robot's (q, q̇, q̈) = ocp.robot_state(node), joint
+  torque τ and its rate dτ/ds as the OCP gives them (`OCP.torque`; for the robot OCP τ = τ_max ∘ u +
+  friction(q̇) and dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈) from the interpolant's slopes du/ds and
+  dẍ/ds (`Slope`), where dt/ds is the transcription's (t_f/(2K) on a pseudospectral segment, h = t_f/N on a
+  mesh interval), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f never divides;
 - the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base);
-- the dynamic defect residual(q, q̇, q̈, τ_max u) at a collocation point;
-- the rows lbg ≤ g ≤ ubg in the order they were added, and the finished `NLP`;
-- the knot columns [q, q̇, q̈, u] of any trajectory (u is its rigid-body torque rnea(q, q̇, q̈) / τ_max, see
-  docs/transcription.md, section "The control u", for why) and the paper's straight-line guess.
+- the OCP's rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) = 0);
+- the robot's jerk times dt/ds at a point (`jerk_s`), which the jerk cost integrates;
+- the rows lbg ≤ g ≤ ubg in the order they were added, and the finished `NLP`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, NamedTuple
 
 import casadi as ca
 import numpy as np
@@ -27,52 +28,46 @@ from ocpkit.constraints import Constraint, Context, PointValues, Rows
 from ocpkit.dynamics import Dynamics
 from ocpkit.nlp import NLP, Layout, Stages
 from ocpkit.problem import Problem
-from ocpkit.robots import Robot, rigid_torque
-from ocpkit.trajectory import Samples, Trajectory
+from ocpkit.transcription.ocp import OCP, Node, RobotOCP, Slope
 
-
-class Node(NamedTuple):
-    """[q, q̇, q̈, u] at one point: CasADi (n, 1) columns, or NumPy (m, n) rows when decoding."""
-
-    q: Any
-    qd: Any
-    qdd: Any
-    u: Any
+__all__ = ["Assembly", "Node", "Slope"]
 
 
 class Assembly:
     """The variables, parameters and rows of one NLP under construction (see the module docstring)."""
 
-    def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint]) -> None:
+    def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
+                 ocp: OCP | None = None) -> None:
         self.robot, self.dynamics, self.constraints = problem.robot, dynamics, tuple(constraints)
+        self.ocp = ocp or RobotOCP(problem.robot)
         self.w, self.p = Layout("w"), Layout("p")
         self.mu, margin, limit_scale = (self.p.add(name) for name in ("mu", "margin", "limit_scale"))
         self.contexts = [Context(dynamics, margin, limit_scale, {
             name: self.p.add(f"{c.name}.{name}", *shape) for name, shape in c.parameter_shapes().items()})
             for c in self.constraints]
-        self.tau_max = ca.DM(self.robot.tau_max)
-        v, a = ca.SX.sym("qd", self.robot.n), ca.SX.sym("qdd", self.robot.n)  # friction'(q̇) a by AD of the law
-        self._friction = ca.Function("friction", [v], [dynamics.friction(v)])
-        self._friction_rate = ca.Function("friction_rate", [v, a], [ca.jtimes(dynamics.friction(v), v, a)])
+        self.ocp.use_parameters({name: self.p.add(f"ocp.{name}", *shape)
+                                 for name, shape in self.ocp.parameter_shapes().items()})
+        self._torque = self.ocp.torque(dynamics)
         self.g: list[ca.SX] = []
         self.lbg: list[np.ndarray] = []
         self.ubg: list[np.ndarray] = []
 
     # -- variables -----------------------------------------------------------------------------------
     def node(self, name: str) -> Node:
-        """New variables [q; q̇; q̈; u] (4n) in w under `name`."""
-        x, n = self.w.add(name, 4 * self.robot.n), self.robot.n
-        return Node(*(x[k * n:(k + 1) * n] for k in range(4)))
+        """New variables [x; ẋ; ẍ; u] (3m + n) in w under `name`."""
+        return self.ocp.split(self.w.add(name, self.ocp.width))
 
     def name_knots(self, knots: Sequence[str], start: int, goal: int) -> None:
-        """Name the knot nodes `knots` (in the transcription's column order) as "X" (K, 4n) and "q", "qd",
-        "qdd", "u" (K, n); the [q, q̇, q̈] of knot `start` as "start" and of knot `goal` as "goal"."""
-        n, X = self.robot.n, np.stack([self.w.index(name) for name in knots])
+        """Name the knot nodes `knots` (in the transcription's column order) as "X" (K, 3m + n), the chain parts
+        by the OCP's names (e.g. "q", "qd", "qdd") (K, m) and "u" (K, n); the [x, ẋ, ẍ] of knot `start` as
+        "start" and of knot `goal` as "goal"."""
+        m, X = self.ocp.chain, np.stack([self.w.index(name) for name in knots])
         self.w.name("X", X)
-        for k, part in enumerate(("q", "qd", "qdd", "u")):
-            self.w.name(part, X[:, k * n:(k + 1) * n])
-        self.w.name("start", X[start, :3 * n])
-        self.w.name("goal", X[goal, :3 * n])
+        for k, part in enumerate(self.ocp.parts):
+            self.w.name(part, X[:, k * m:(k + 1) * m])
+        self.w.name("u", X[:, 3 * m:])
+        self.w.name("start", X[start, :3 * m])
+        self.w.name("goal", X[goal, :3 * m])
 
     # -- rows ----------------------------------------------------------------------------------------
     @property
@@ -91,28 +86,32 @@ class Assembly:
         self.add(Rows(expr, 0.0, 0.0))
 
     def dynamics_defect(self, x: Node) -> None:
-        """The dynamics at one collocation point: residual(q, q̇, q̈, τ_max u) = 0."""
-        self.defect(self.dynamics.residual(x.q, x.qd, x.qdd, self.tau_max * x.u))
+        """The OCP's rows at one collocation point (`OCP.defect`: the dynamics for the robot OCP) = 0."""
+        self.defect(self.ocp.defect(self.dynamics, x))
 
-    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> PointValues:
-        """Values at one point; du_ds is du/ds, so dτ/ds = τ_max du_ds + friction'(q̇) (dt/ds) q̈."""
-        return PointValues(x.q, x.qd, x.qdd, self.tau_max * x.u + self._friction(x.qd),
-                           self.tau_max * du_ds + self._friction_rate(x.qd, dt_ds * x.qdd), dt_ds)
+    def jerk_s(self, x: Node, dxdd_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
+        """The robot's jerk times dt/ds (n, 1) at a point where the chain's ẍ has slope dẍ/ds = `dxdd_ds`."""
+        return self.ocp.jerk_s(x, dxdd_ds, dt_ds)
 
-    def path(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, at_knot: bool = False) -> None:
+    def point(self, x: Node, slope: Slope, dt_ds: ca.SX) -> PointValues:
+        """Values at one point where the interpolant has the slopes `slope` (du/ds, dẍ/ds)."""
+        tau, dtau_ds = self._torque(x, slope, dt_ds)
+        return PointValues(*self.ocp.robot_state(x), tau, dtau_ds, dt_ds)
+
+    def path(self, x: Node, slopes: Sequence[Slope], dt_ds: ca.SX, at_knot: bool = False) -> None:
         """Every path constraint at one point, in the constraints' order: those not reading rates once (at a
-        knot, less those imposed as knot bounds), those reading dτ/ds once per one-sided slope du/ds in
-        `slopes` (none without slopes)."""
+        knot, less those imposed as knot bounds where the OCP's chain is q), those reading dτ/ds once per
+        one-sided slope in `slopes` (none without slopes)."""
         first, *others = [self.point(x, slope, dt_ds) for slope in slopes] or [
-            self.point(x, ca.SX.zeros(self.robot.n), dt_ds)]
+            self.point(x, Slope(ca.SX.zeros(self.ocp.algebraic), ca.SX.zeros(self.ocp.chain)), dt_ds)]
         for constraint, context in zip(self.constraints, self.contexts):
-            if _imposed(constraint, bool(slopes), at_knot):
+            if _imposed(constraint, bool(slopes), at_knot and self.ocp.knot_bounds):
                 self.add(constraint.evaluate(first, context))
         for values in others:
             self._rates(values)
 
-    def rates(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX) -> None:
-        """The constraints reading dτ/ds at one point, once per one-sided slope du/ds in `slopes`."""
+    def rates(self, x: Node, slopes: Sequence[Slope], dt_ds: ca.SX) -> None:
+        """The constraints reading dτ/ds at one point, once per one-sided slope in `slopes`."""
         for slope in slopes:
             self._rates(self.point(x, slope, dt_ds))
 
@@ -134,29 +133,3 @@ def _imposed(constraint: Constraint, with_rate: bool, at_knot: bool) -> bool:
     if constraint.reads_rate:
         return with_rate
     return not (at_knot and constraint.at_knots == "bounds")
-
-
-def knot_columns(robot: Robot, samples: Samples) -> np.ndarray:
-    """Rows [q, q̇, q̈, u] (m, 4n) of sampled values, u = rnea(q, q̇, q̈) / τ_max (the rigid-body torque)."""
-    rigid = rigid_torque(robot, samples.q, samples.qd, samples.qdd)
-    return np.hstack([samples.q, samples.qd, samples.qdd, rigid / robot.tau_max])
-
-
-def joint_samples(robot: Robot, t: np.ndarray, x: Node, du_dt: np.ndarray) -> Samples:
-    """Samples from interpolated [q, q̇, q̈, u] rows and du/dt: τ = τ_max u + friction(q̇), τ̇ = τ_max u̇ +
-    friction'(q̇) q̈ (the torque the plan commands; verify compares it with rnea(q, q̇, q̈) + friction(q̇))."""
-    return Samples(np.asarray(t, dtype=float), x.q, x.qd, x.qdd, robot.tau_max * x.u + robot.friction(x.qd),
-                   robot.tau_max * du_dt + robot.friction_slope(x.qd) * x.qdd)
-
-
-def straight_line(problem: Problem) -> Trajectory:
-    """The paper's initial guess: start to goal at constant joint speed over t_f = time.guess (infeasible at
-    the ends, where it does not start and stop at rest)."""
-    tf, delta = problem.time.guess, problem.goal - problem.start
-
-    def line(t: np.ndarray) -> Samples:
-        zeros = np.zeros((len(t), problem.robot.n))
-        return Samples(t, problem.start + np.outer(t / tf, delta), np.tile(delta / tf, (len(t), 1)), zeros, zeros,
-                       zeros)
-
-    return Trajectory(line(np.array([0.0, tf])), line)

@@ -9,6 +9,7 @@ one prepared solver). The equations of every transcription are in docs/transcrip
 
 from __future__ import annotations
 
+import copy
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from itertools import count
@@ -25,36 +26,38 @@ from ocpkit.nlp import NLP, Refinement
 from ocpkit.problem import Problem
 from ocpkit.registry import Registry
 from ocpkit.trajectory import Trajectory
-from ocpkit.transcription.assembly import straight_line
+from ocpkit.transcription.ocp import OCP
 
 
 class Discretization(ABC):
     """An NLP built for problems of one shape, with the maps from such a problem to bounds, parameters and a
     guess, and from a solution back to a Trajectory. Parts of the NLP's vectors are read by name:
 
-      variables   "q", "qd", "qdd", "u": (knots, n) at every knot;  "start", "goal": [q, q̇, q̈] (3n,) at the
-                  start and goal knots;  "tf": every copy of t_f
-      parameters  "mu", "margin", "limit_scale", "<constraint>.<name>" per constraint, then the transcription's
-                  own (`own_parameters`)
+      variables   the OCP's chain parts ("q", "qd", "qdd" for the robot OCP) (knots, m) and "u" (knots, n) at
+                  every knot;  "start", "goal": [x, ẋ, ẍ] (3m,) at the start and goal knots;  "tf": every copy
+                  of t_f
+      parameters  "mu", "margin", "limit_scale", "<constraint>.<name>" per constraint, "ocp.<name>" per OCP
+                  parameter, then the transcription's own (`own_parameters`)
 
-    `margin` (m) is the default clearance margin."""
+    `margin` (m) is the default clearance margin; `ocp` the OCP discretized (ocpkit.transcription.ocp)."""
 
-    def __init__(self, nlp: NLP, constraints: Sequence[Constraint], margin: float) -> None:
-        self.nlp, self.constraints, self.margin = nlp, tuple(constraints), margin
+    def __init__(self, nlp: NLP, constraints: Sequence[Constraint], margin: float, ocp: OCP) -> None:
+        self.nlp, self.constraints, self.margin, self.ocp = nlp, tuple(constraints), margin, ocp
 
     def bounds(self, problem: Problem, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
-        """(lbx, ubx): the knot bounds of the constraints imposed that way, start and goal at rest (eq. (10)),
-        the time bounds; everything else free."""
+        """(lbx, ubx): the knot bounds of the constraints imposed that way (where the OCP's chain is q), the OCP's
+        own chain bounds, start and goal at rest (eq. (10)), the time bounds; everything else free."""
         w = self.nlp.variables
         lbx, ubx = np.full(w.size, -np.inf), np.full(w.size, np.inf)
-        for constraint in self.constraints:
-            for name, (lower, upper) in constraint.variable_bounds(refinement.limit_scale).items():
+        knot_bounds = [c.variable_bounds(refinement.limit_scale) for c in self.constraints] if self.ocp.knot_bounds \
+            else []
+        for bounds in [*knot_bounds, self.ocp.chain_bounds()]:
+            for name, (lower, upper) in bounds.items():
                 w.write(lbx, name, lower)
                 w.write(ubx, name, upper)
-        rest = np.zeros(2 * problem.robot.n)
-        for name, q in (("start", problem.start), ("goal", problem.goal)):
-            w.write(lbx, name, np.concatenate([q, rest]))
-            w.write(ubx, name, np.concatenate([q, rest]))
+        for name, values in zip(("start", "goal"), self.ocp.end_values(problem)):
+            w.write(lbx, name, values)
+            w.write(ubx, name, values)
         w.write(lbx, "tf", problem.time.min)
         w.write(ubx, "tf", problem.time.max)
         return lbx, ubx
@@ -71,13 +74,23 @@ class Discretization(ABC):
         shared = {"mu": problem.mu, "margin": margin, "limit_scale": refinement.limit_scale}
         owned = {f"{c.name}.{name}": value for c in self.constraints for name, value in
                  c.parameter_values(problem).items()}
+        owned.update({f"ocp.{name}": value for name, value in self.ocp.parameter_values().items()})
         for name, value in {**shared, **owned, **self.own_parameters(refinement)}.items():
             p.write(values, name, value)
         return values
 
+    def with_ocp(self, ocp: OCP) -> Discretization:
+        """This discretization for another OCP of the same key (its numbers: parameters, encode, decode)."""
+        if ocp.key != self.ocp.key:
+            raise ValueError(f"an OCP of key {ocp.key} cannot use the NLP built for key {self.ocp.key}")
+        other = copy.copy(self)
+        other.ocp = ocp
+        return other
+
     def initial_guess(self, problem: Problem) -> np.ndarray:
-        """The paper's guess: the straight joint-space line over t_f = time.guess (`assembly.straight_line`)."""
-        return self.encode(straight_line(problem))
+        """The OCP's default guess (`OCP.guess`): for the robot OCP the paper's straight joint-space line over
+        t_f = time.guess (`ocp.straight_line`)."""
+        return self.encode(self.ocp.guess(problem))
 
     @abstractmethod
     def own_parameters(self, refinement: Refinement) -> dict[str, np.ndarray]:
@@ -85,7 +98,8 @@ class Discretization(ABC):
 
     @abstractmethod
     def encode(self, trajectory: Trajectory) -> np.ndarray:
-        """A decision vector w that samples `trajectory` (any planner's) on this NLP's grid: a warm start."""
+        """A decision vector w that samples `trajectory` on this NLP's grid: a warm start. For the robot OCP any
+        planner's trajectory; for another OCP a trajectory of its chain (x, ẋ, ẍ in the Samples' q, qd, qdd)."""
 
     @abstractmethod
     def decode(self, w: np.ndarray) -> Trajectory:
@@ -127,15 +141,17 @@ class Transcription(ABC):
     def options_key(self) -> tuple:
         """Hashable: the options that shape the NLP."""
 
-    def shape_key(self, dynamics: Dynamics, constraints: Sequence[Constraint]) -> tuple:
+    def shape_key(self, dynamics: Dynamics, constraints: Sequence[Constraint], ocp: OCP | None = None) -> tuple:
         """Hashable, equal for problems that can share one build: the options, the dynamics backend (its robot
-        included), each constraint's class and shape. Start, goal, time bounds, μ and obstacle positions are
-        numbers."""
-        return self.options_key(), dynamics.key, tuple((type(c), c.shape()) for c in constraints)
+        included), each constraint's class and shape, and the OCP's key unless it is the robot OCP (None). Start,
+        goal, time bounds, μ and obstacle positions are numbers."""
+        key = self.options_key(), dynamics.key, tuple((type(c), c.shape()) for c in constraints)
+        return key if ocp is None else (*key, ocp.key)
 
     @abstractmethod
-    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint]) -> Discretization:
-        """The Discretization for problems of this problem's shape."""
+    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
+              ocp: OCP | None = None) -> Discretization:
+        """The Discretization of `ocp` (the robot OCP of problems of this problem's shape by default)."""
 
 
 TRANSCRIPTIONS: Registry[type[Transcription]] = Registry("transcription", "ocpkit.transcriptions")

@@ -1,7 +1,8 @@
 """Local collocation on a uniform mesh: what trapezoidal and Hermite–Simpson share.
 
 A method (trapezoidal.py, hermite_simpson.py) gives only its math: `collocation` (its defects on one interval),
-`interpolate` (q, q̇, q̈, u, du/dσ at σ: one formula for the NLP rows and for `decode`) and `jerk_integral`;
+`interpolate` (x, ẋ, ẍ, u, du/dσ, dẍ/dσ at σ: one formula for the NLP rows and for `decode`) and `jerk_rule`
+(the quadrature of the jerk cost on an interval);
 `MeshDiscretization` assembles the same NLP around it for both. Variables and rows are created stage by stage
 (stage k: knot k, then interval k's midpoint, check and rows), so the KKT matrix is block-banded; `staged=True`
 adds the exact stage structure fatrop needs (`ocpkit.nlp.Stages`): per-stage t_f copies T_k, end-of-interval
@@ -23,22 +24,29 @@ from ocpkit.constraints import Constraint
 from ocpkit.dynamics import Dynamics
 from ocpkit.nlp import Refinement, Stages
 from ocpkit.problem import Problem
-from ocpkit.robots import Robot
 from ocpkit.trajectory import Samples, Trajectory
-from ocpkit.transcription.assembly import Assembly, Node, joint_samples, knot_columns
+from ocpkit.transcription.assembly import Assembly, Node, Slope
 from ocpkit.transcription.base import Discretization, Transcription
+from ocpkit.transcription.ocp import OCP, RobotOCP
 
 CHECK_RANGE = (0.1, 0.9)  # a moved check keeps this far (fraction of h) from the knots, whose rows it would repeat
 
 
 class Local(NamedTuple):
-    """The interpolant at σ inside an interval, and the slope du/dσ of the scaled rigid-body torque."""
+    """The interpolant [x, ẋ, ẍ, u] at σ inside an interval, the slope du/dσ of the scaled rigid-body torque and
+    the slope dẍ/dσ (the chain's jerk times h)."""
 
     q: Any
     qd: Any
     qdd: Any
     u: Any
     du_ds: Any
+    dqdd_ds: Any
+
+    @property
+    def slope(self) -> Slope:
+        """(du/dσ, dẍ/dσ)."""
+        return Slope(self.du_ds, self.dqdd_ds)
 
 
 Interpolate = Callable[[Node, Node, "Node | None", Any, Any], Local]
@@ -48,28 +56,31 @@ class MeshInterpolant:
     """The method's interpolant of decoded knot (and midpoint) rows, for any t in [0, t_f]."""
 
     def __init__(self, tf: float, knots: np.ndarray, mids: np.ndarray | None, interpolate: Interpolate,
-                 robot: Robot) -> None:
-        self.tf, self.knots, self.mids, self.interpolate, self.robot = tf, knots, mids, interpolate, robot
+                 ocp: OCP) -> None:
+        self.tf, self.knots, self.mids, self.interpolate, self.ocp = tf, knots, mids, interpolate, ocp
 
     def __call__(self, t: np.ndarray) -> Samples:
         N = len(self.knots) - 1
         h = self.tf / N
         at = np.asarray(t, dtype=float) / h
         k = np.clip(np.floor(at).astype(int), 0, N - 1)  # interval of each t; t_f belongs to the last
-        node = lambda rows: Node(*np.split(rows, 4, axis=1))  # noqa: E731
+        node = self.ocp.split
         mid = None if self.mids is None else node(self.mids[k])
         v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, h, (at - k)[:, None])
-        return joint_samples(self.robot, t, Node(v.q, v.qd, v.qdd, v.u), v.du_ds / h)
+        return self.ocp.samples(t, Node(v.q, v.qd, v.qdd, v.u), v.du_ds / h, v.dqdd_ds / h)
 
 
 class MeshDiscretization(Discretization):
-    """The NLP of one shape for a local collocation method (module docstring); subclasses give `midpoints` and
-    the three static methods. Variables per stage k: "knot{k}", ("tf{k}" if staged), "mid{k}" (if midpoints),
-    "q_check{k}", ("end{k}" if staged); "tf" once at the end unless staged. Named: "X" (N+1, 4n), "M" (N, 4n),
-    "E" (N, 4n), "q_check" (N, n), "tf" (every copy). Own parameter "check_at" (N,): σ of each interval's check."""
+    """The NLP of `ocp` (one shape) for a local collocation method (module docstring); subclasses give
+    `midpoints`, `jerk_rule` and the two static methods. Variables per stage k: "knot{k}", ("tf{k}" if staged),
+    "mid{k}" (if midpoints), "q_check{k}", ("end{k}" if staged); "tf" once at the end unless staged. Named: "X"
+    (N+1, 3m + n), "M" (N, 3m + n), "E" (N, 3m + n), "q_check" (N, m), "tf" (every copy).
+    Own parameter "check_at" (N,): σ of each interval's check."""
 
     midpoints: bool = False
     check_default: float = 0.5  # σ of every interval's check before any refinement
+    jerk_rule: tuple[tuple[float, ...], tuple[float, ...]]
+    """(σ points, weights) of the quadrature of ∫ (dq̈/dσ)ᵀ Q (dq̈/dσ) dσ over [0, 1]: exact for the robot OCP."""
 
     @staticmethod
     @abstractmethod
@@ -81,16 +92,11 @@ class MeshDiscretization(Discretization):
     def interpolate(x0: Node, x1: Node, xm: Node | None, h: Any, s: Any) -> Local:
         """The interval's own interpolant at σ = s ∈ [0, 1] (CasADi symbols or NumPy arrays)."""
 
-    @staticmethod
-    @abstractmethod
-    def jerk_integral(x0: Node, x1: Node, xm: Node | None, weights: ca.DM) -> ca.SX:
-        """∫ (dq̈/dσ)ᵀ Q (dq̈/dσ) dσ over the interval by the method's quadrature (weights = diag Q)."""
-
     def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint], knots: int,
-                 margin: float, staged: bool, shape_key: tuple) -> None:
-        n, N = problem.robot.n, knots
-        self.n, self.N, self.robot, self.staged = n, N, problem.robot, staged
-        a = Assembly(problem, dynamics, constraints)
+                 margin: float, staged: bool, shape_key: tuple, ocp: OCP) -> None:
+        N = knots
+        self.m, self.N, self.staged = ocp.chain, N, staged
+        a = Assembly(problem, dynamics, constraints, ocp)
         x, T, mids, checks, ends = self._variables(a, N, staged)
         check_at = a.p.add("check_at", N)
 
@@ -107,21 +113,30 @@ class MeshDiscretization(Discretization):
             else:
                 end = ends[k] if staged else x[k + 1]
                 local = lambda s: self.interpolate(x[k], end, mids[k], h, s)  # noqa: E731
-                a.path(x[k], [local(0.0).du_ds], h, at_knot=True)  # the slope leaving knot k
+                a.path(x[k], [local(0.0).slope], h, at_knot=True)  # the slope leaving knot k
                 self.collocation(a, h, x[k], end, mids[k])
                 if self.midpoints:
                     a.dynamics_defect(mids[k])
                 v = local(check_at[k])
                 a.defect(checks[k] - v.q)
-                a.path(Node(checks[k], v.qd, v.qdd, v.u), [v.du_ds], h)
-                a.rates(end, [local(1.0).du_ds], h)  # the slope entering knot k + 1
-                jerk += self.jerk_integral(x[k], end, mids[k], ca.DM(problem.jerk_weights)) / h
+                a.path(Node(checks[k], v.qd, v.qdd, v.u), [v.slope], h)
+                a.rates(end, [local(1.0).slope], h)  # the slope entering knot k + 1
+                jerk += self._jerk_integral(a, local, h, ca.DM(problem.jerk_weights)) / h
             rows.append(a.row_count - first)
         stages = None
         if staged:
-            controls = a.w.index("end0").size + a.w.index("q_check0").size + (4 * n if self.midpoints else 0)
-            stages = Stages((4 * n + 1,) * (N + 1), (controls,) * N + (0,), tuple(rows))
-        super().__init__(a.nlp(T[0] + a.mu * jerk, shape_key, stages), constraints, margin)
+            controls = a.w.index("end0").size + a.w.index("q_check0").size + (ocp.width if self.midpoints else 0)
+            stages = Stages((ocp.width + 1,) * (N + 1), (controls,) * N + (0,), tuple(rows))
+        super().__init__(a.nlp(T[0] + a.mu * jerk, shape_key, stages), constraints, margin, ocp)
+
+    def _jerk_integral(self, a: Assembly, local: Callable[[Any], Local], h: ca.SX, weights: ca.DM) -> ca.SX:
+        """∫ (dq̈/dσ)ᵀ Q (dq̈/dσ) dσ over one interval by `jerk_rule` (weights = diag Q)."""
+        total = 0
+        for s, c in zip(*self.jerk_rule):
+            v = local(s)
+            j = a.jerk_s(Node(v.q, v.qd, v.qdd, v.u), v.dqdd_ds, h)
+            total += c * ca.dot(weights * j, j)
+        return total
 
     def _variables(self, a: Assembly, N: int, staged: bool) -> tuple[list, list, list, list, list]:
         """Create w stage by stage (class docstring); (knots, t_f per stage, midpoints, check q, end values)."""
@@ -132,7 +147,7 @@ class MeshDiscretization(Discretization):
                 T.append(a.w.add(f"tf{k}"))
             if k < N:
                 mids.append(a.node(f"mid{k}") if self.midpoints else None)
-                checks.append(a.w.add(f"q_check{k}", self.n))
+                checks.append(a.w.add(f"q_check{k}", self.m))
                 if staged:
                     ends.append(a.node(f"end{k}"))
         if not staged:
@@ -163,10 +178,10 @@ class MeshDiscretization(Discretization):
         tf, N, w = trajectory.tf, self.N, self.nlp.variables
         at = lambda s: trajectory.interpolant(tf * s / N)  # noqa: E731  s in intervals
         intervals, values = np.arange(N), np.zeros(w.size)
-        knots = knot_columns(self.robot, at(np.arange(N + 1.0)))
+        knots = self.ocp.columns(at(np.arange(N + 1.0)))
         w.write(values, "X", knots)
         if self.midpoints:
-            w.write(values, "M", knot_columns(self.robot, at(intervals + 0.5)))
+            w.write(values, "M", self.ocp.columns(at(intervals + 0.5)))
         if self.staged:
             w.write(values, "E", knots[1:])
         w.write(values, "q_check", at(intervals + self.check_default).q)
@@ -177,7 +192,7 @@ class MeshDiscretization(Discretization):
         layout = self.nlp.variables
         knots, tf = layout.read(w, "X"), float(layout.read(w, "tf")[0])
         mids = layout.read(w, "M") if self.midpoints else None
-        interpolant = MeshInterpolant(tf, knots, mids, self.interpolate, self.robot)
+        interpolant = MeshInterpolant(tf, knots, mids, self.interpolate, self.ocp)
         return Trajectory(interpolant(tf * np.arange(self.N + 1) / self.N), interpolant)
 
 
@@ -202,6 +217,7 @@ class MeshTranscription(Transcription):
     def options_key(self) -> tuple:
         return self.name, self.knots, self.margin, self.staged
 
-    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint]) -> MeshDiscretization:
+    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
+              ocp: OCP | None = None) -> MeshDiscretization:
         return self.discretization(problem, dynamics, constraints, self.knots, self.margin, self.staged,
-                                   self.shape_key(dynamics, constraints))
+                                   self.shape_key(dynamics, constraints, ocp), ocp or RobotOCP(problem.robot))

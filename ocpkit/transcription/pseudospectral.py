@@ -25,10 +25,10 @@ from ocpkit.dynamics import Dynamics
 from ocpkit.errors import OptionError
 from ocpkit.nlp import Refinement
 from ocpkit.problem import Problem
-from ocpkit.robots import Robot
 from ocpkit.trajectory import Samples, Trajectory
-from ocpkit.transcription.assembly import Assembly, Node, joint_samples, knot_columns
+from ocpkit.transcription.assembly import Assembly, Node, Slope
 from ocpkit.transcription.base import Discretization, Transcription
+from ocpkit.transcription.ocp import OCP, RobotOCP
 from ocpkit.transcription.polynomials import NodeFamily
 
 
@@ -69,19 +69,18 @@ class Grid:
 
 @dataclass(frozen=True)
 class PseudospectralInterpolant:
-    """The piecewise barycentric interpolant of the knot values; `columns` is (4n, KN + 1) in column order."""
+    """The piecewise barycentric interpolant of the knot values; `columns` is (3m + n, KN + 1) in column order."""
 
     tf: float
     columns: np.ndarray
-    robot: Robot
+    ocp: OCP
     grid: Grid
 
     def __call__(self, t: np.ndarray) -> Samples:
-        n = self.robot.n
         L, Ld = self.grid.matrices(2.0 * np.asarray(t, dtype=float) / self.tf - 1.0)
-        values = L @ self.columns.T
-        du_dt = Ld @ self.columns[3 * n:].T * (2.0 * self.grid.K / self.tf)
-        return joint_samples(self.robot, t, Node(*np.split(values, 4, axis=1)), du_dt)
+        values, rates = L @ self.columns.T, Ld @ self.columns.T * (2.0 * self.grid.K / self.tf)
+        m = self.ocp.chain
+        return self.ocp.samples(t, self.ocp.split(values), rates[:, 3 * m:], rates[:, 2 * m:3 * m])
 
 
 def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
@@ -91,26 +90,25 @@ def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
 
 
 class PseudospectralDiscretization(Discretization):
-    """The NLP of one shape on `grid` (docs/transcription.md), with the maps from a problem to its numbers and
-    back. Variables: knot columns "knot0".. in column order (named "X", "q", ... by the assembly), "q_check"
-    (n, checks), "tf"; own parameters "adaptive_rows", "adaptive_drows" (slots, KN + 1): L(σ_k) and d/ds L(σ_k)
-    of the adaptive check slots."""
+    """The NLP of `ocp` (one shape) on `grid` (docs/transcription.md), with the maps from a problem to its numbers
+    and back. Variables: knot columns "knot0".. in column order (named "X", "q", ... by the assembly), "q_check"
+    (m, checks: the chain's x), "tf"; own parameters "adaptive_rows", "adaptive_drows" (slots, KN + 1): L(σ_k)
+    and d/ds L(σ_k) of the adaptive check slots."""
 
     def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint], grid: Grid,
-                 margin: float, adaptive_checks: int, shape_key: tuple) -> None:
-        robot = problem.robot
-        n, N, K = robot.n, grid.N, grid.K
-        self.n, self.grid, self.robot = n, grid, robot
+                 margin: float, adaptive_checks: int, shape_key: tuple, ocp: OCP) -> None:
+        N, K = grid.N, grid.K
+        self.grid = grid
         D, weights = grid.family.differentiation(N), grid.family.quadrature_weights(N)
         collocated, points = grid.family.collocation_mask(N), grid.family.points(N)
         self.check_sigma = grid.in_segments(long_interval_midpoints(points))
         self.adaptive_default = grid.to_global(K // 2, middle_quarter_points(points, adaptive_checks))
         columns = K * N + 1
 
-        a = Assembly(problem, dynamics, constraints)
+        a = Assembly(problem, dynamics, constraints, ocp)
         x = [a.node(f"knot{j}") for j in range(columns)]  # column j at σ_j: t_f first, the start last
         a.name_knots([f"knot{j}" for j in range(columns)], start=columns - 1, goal=0)
-        Qc = a.w.add("q_check", n, len(self.check_sigma) + adaptive_checks)
+        Qc = a.w.add("q_check", ocp.chain, len(self.check_sigma) + adaptive_checks)
         tf = a.w.add("tf")
         rows = a.p.add("adaptive_rows", adaptive_checks, columns)  # L(σ_k), one row per slot
         drows = a.p.add("adaptive_drows", adaptive_checks, columns)  # d/ds L(σ_k)
@@ -127,12 +125,13 @@ class PseudospectralDiscretization(Discretization):
                 if collocated[i]:
                     a.defect(q_defect[i, :].T)
                     a.defect(qd_defect[i, :].T)
+                slope = Slope(du_ds[i, :].T, dqdd_ds[i, :].T)
                 if b > 0 and i == 0:  # the joint with segment b − 1: its other one-sided torque rate
-                    a.rates(node, [du_ds[i, :].T], h)
+                    a.rates(node, [slope], h)
                 else:
                     a.dynamics_defect(node)
-                    a.path(node, [du_ds[i, :].T], h, at_knot=True)
-            jerk_s.append(ca.vec(dqdd_ds.T))  # (D Q̈_b) point by point; jerk = jerk_s / h
+                    a.path(node, [slope], h, at_knot=True)
+                jerk_s.append(a.jerk_s(node, dqdd_ds[i, :].T, h))  # from (D Ẍ_b) point by point; jerk = jerk_s / h
 
         fixed_rows, fixed_drows = grid.matrices(self.check_sigma)
         L, Ld = ca.vertcat(ca.DM(fixed_rows), rows), ca.vertcat(ca.DM(fixed_drows), drows)
@@ -140,11 +139,12 @@ class PseudospectralDiscretization(Discretization):
         for k in range(L.size1()):
             row, drow = ca.transpose(L[k, :]), ca.transpose(Ld[k, :])
             a.defect(Qc[:, k] - ca.mtimes(Q, row))
-            a.path(Node(Qc[:, k], ca.mtimes(Qd, row), ca.mtimes(Qdd, row), ca.mtimes(U, row)), [ca.mtimes(U, drow)], h)
+            a.path(Node(Qc[:, k], ca.mtimes(Qd, row), ca.mtimes(Qdd, row), ca.mtimes(U, row)),
+                   [Slope(ca.mtimes(U, drow), ca.mtimes(Qdd, drow))], h)
 
         quad = ca.DM(np.kron(np.tile(weights, K), problem.jerk_weights))
         objective = tf + a.mu * (2.0 * K / tf) * ca.dot(quad, ca.vertcat(*jerk_s) ** 2)
-        super().__init__(a.nlp(objective, shape_key), constraints, margin)
+        super().__init__(a.nlp(objective, shape_key), constraints, margin, ocp)
 
     # -- numbers for one problem -------------------------------------------------------------------
     def own_parameters(self, refinement: Refinement) -> dict[str, np.ndarray]:
@@ -162,7 +162,7 @@ class PseudospectralDiscretization(Discretization):
         at = lambda sigma: trajectory.interpolant(tf * (sigma + 1.0) / 2.0)  # noqa: E731
         knots, checks = at(self.grid.knots), at(np.concatenate([self.check_sigma, self.adaptive_default]))
         values = np.zeros(w.size)
-        w.write(values, "X", knot_columns(self.robot, knots))
+        w.write(values, "X", self.ocp.columns(knots))
         w.write(values, "q_check", checks.q.T)
         w.write(values, "tf", tf)
         return values
@@ -170,7 +170,7 @@ class PseudospectralDiscretization(Discretization):
     def decode(self, w: np.ndarray) -> Trajectory:
         layout = self.nlp.variables
         columns, tf = layout.read(w, "X").T, float(layout.read(w, "tf")[0])
-        interpolant = PseudospectralInterpolant(tf, columns, self.robot, self.grid)
+        interpolant = PseudospectralInterpolant(tf, columns, self.ocp, self.grid)
         return Trajectory(interpolant(tf * (self.grid.knots[::-1] + 1.0) / 2.0), interpolant)
 
 
@@ -217,8 +217,8 @@ class Pseudospectral(Transcription):
     def options_key(self) -> tuple:
         return self.name, self.knots, self.segments, self.margin, self.adaptive_checks
 
-    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint]
-              ) -> PseudospectralDiscretization:
+    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
+              ocp: OCP | None = None) -> PseudospectralDiscretization:
         return PseudospectralDiscretization(problem, dynamics, constraints, Grid(self.family, self.knots,
                                             self.segments), self.margin, self.adaptive_checks,
-                                            self.shape_key(dynamics, constraints))
+                                            self.shape_key(dynamics, constraints, ocp), ocp or RobotOCP(problem.robot))

@@ -28,6 +28,7 @@ class TrapezoidalDiscretization(MeshDiscretization):
     """Trapezoidal collocation on N intervals (module docstring); no midpoint variables."""
 
     midpoints = False
+    jerk_rule = ((0.5,), (1.0,))  # (dq̈/dσ)² is constant on an interval for the robot OCP
 
     @staticmethod
     def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: None) -> None:
@@ -38,12 +39,8 @@ class TrapezoidalDiscretization(MeshDiscretization):
     def interpolate(x0: Node, x1: Node, xm: None, h: Any, s: Any) -> Local:
         return Local(q=quadratic_state(x0.q, x1.q, x0.qd, x1.qd, h, s),
                      qd=quadratic_state(x0.qd, x1.qd, x0.qdd, x1.qdd, h, s),
-                     qdd=x0.qdd + s * (x1.qdd - x0.qdd), u=x0.u + s * (x1.u - x0.u), du_ds=x1.u - x0.u)
-
-    @staticmethod
-    def jerk_integral(x0: Node, x1: Node, xm: None, weights: ca.DM) -> ca.SX:
-        change = x1.qdd - x0.qdd  # dq̈/dσ, constant on the interval
-        return ca.dot(weights * change, change)
+                     qdd=x0.qdd + s * (x1.qdd - x0.qdd), u=x0.u + s * (x1.u - x0.u), du_ds=x1.u - x0.u,
+                     dqdd_ds=x1.qdd - x0.qdd)
 
 
 class Trapezoidal(MeshTranscription):

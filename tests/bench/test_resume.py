@@ -75,7 +75,7 @@ def test_ctrl_c_keeps_finished_rows_and_a_rerun_completes_each_row_once(tmp_path
     rows = file_rows(out / "results.csv")
     assert rows[:len(kept)] == kept
     keys = [row_key(r) for r in rows]
-    assert len(keys) == len(set(keys)) == 6  # 4 simultaneous (2 dynamics x 2 knot counts), baseline, matched
+    assert len(keys) == len(set(keys)) == 7  # 4 simultaneous (2 dynamics x 2 knot counts), 2 baselines, matched
     assert "motion time t_f" in rerun.stdout and "ratio sim / baseline" in rerun.stdout
     assert f"results: {out / 'results.csv'}" in rerun.stdout
 

@@ -96,10 +96,14 @@ def test_paper_benchmark_writes_csv_and_trajectories(tmp_path, capsys):
         ("simultaneous", "casadi-rnea", "12", "verified"), ("simultaneous", "casadi-rnea", "8", "verified"),
         ("simultaneous", "casadi", "12", "verified"), ("simultaneous", "casadi", "8", "verified")]
     assert rows[4]["planner"] == "ompl-toppra" and rows[4]["status"] in ("verified", "violated")
+    assert (rows[5]["planner"], rows[5]["transcription"], rows[5]["knots"], rows[5]["status"]) == (
+        "ompl-topp3", "chebyshev", "12", "verified")
     assert (tmp_path / "out/trajectories/case4-ompl-toppra.json").exists()
+    assert (tmp_path / "out/trajectories/case4-ompl-topp3-chebyshev-12.json").exists()
     assert (tmp_path / "out/trajectories/case4-simultaneous-chebyshev-12.json").exists()
     printed = capsys.readouterr().out
     assert "motion time t_f" in printed and "paper set-up" in printed and "ratio sim / baseline" in printed
+    assert "ratio sim / ompl-topp3" in printed and "ompl-toppra violation" in printed
 
 
 def test_refinement_repairs_contact_between_check_times():

@@ -1,0 +1,155 @@
+"""`ompl-topp3`: the decomposition baseline held to the simultaneous planner's limits and cost.
+
+1. The OMPL path exactly as `ompl-toppra` finds it (ompl_toppra.py: same validity checker, planner, seed and
+   shortcutting).
+2. Made smooth to its third derivative: the natural quintic spline in the chord length (`PathSpline`), re-checked
+   densely and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4 rad, and the joint
+   position limits, which the timing cannot change). Its parameter is normalised: q = p(s), s ∈ [0, 1].
+3. The timing along that fixed path as an optimal control problem in s (`PathTimingOCP`): s(t) from rest at 0 to
+   rest at 1, q̇ = p′ṡ, q̈ = p′s̈ + p″ṡ², q⃛ = p′s⃛ + 3p″ṡs̈ + p‴ṡ³, τ = RNEA(q, q̇, q̈) + friction; the
+   velocity, torque and torque-rate limits and the cost t_f + μ∫q⃛ᵀQq⃛ dt of the simultaneous planner. It is
+   transcribed and solved by ocpkit's own transcriptions and solvers (the same arguments as
+   `plan_simultaneous`: transcription, knots, dynamics, solver, ...), solved with the same refinement rounds,
+   warm-started from the TOPP-RA profile of the same path (`_time_optimal`; where TOPP-RA cannot time it, from
+   s moving at constant speed over time.guess, `PathTimingOCP.guess`). The path enters the NLP as
+   parameters, its pieces split up to a multiple of PIECES_STEP, so paths share one build (the build cache's,
+   like the simultaneous planner's shapes) and its one-time set-up is not computation.
+   Collision is not a constraint of the timing: the path is fixed and was checked; `verify` checks it again.
+
+The motion returned is q(t) = p(s(t)) at every sample, so it stays on the checked path by construction.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ocpkit.baselines.ompl_toppra import (_hold, _import_backends, _ompl_path, _smooth_path, _time_optimal,
+                                         check_ompl_planner, planning_space)
+from ocpkit.build_cache import build
+from ocpkit.dynamics import Dynamics
+from ocpkit.path_spline import PathSpline
+from ocpkit.plan import Plan, finish
+from ocpkit.problem import Problem
+from ocpkit.refine import DEFAULT_ROUNDS, Refined, solve_refined
+from ocpkit.solvers import SolverStatus
+from ocpkit.trajectory import Samples, Trajectory
+from ocpkit.transcription.ocp import PathTimingOCP
+
+PIECES_STEP = 4  # the path's polynomial pieces are rounded up to a multiple of this: one NLP per multiple
+TIMING_CONSTRAINTS = ("state-limits", "torque", "torque-rate")
+"""The simultaneous planner's limits; collision is left to the path (fixed and checked) and to `verify`."""
+
+
+class ToppraPath:
+    """A PathSpline as toppra's geometric path on s ∈ [0, 1] (orders 0 to 2; the interface of toppra's
+    AbstractGeometricPath, which toppra reads by duck typing)."""
+
+    def __init__(self, spline: PathSpline) -> None:
+        self.spline = spline
+
+    def __call__(self, s: Any, order: int = 0) -> np.ndarray:
+        values = self.spline.values(np.atleast_1d(np.asarray(s, dtype=float)))[order]
+        return values[0] if np.isscalar(s) else values
+
+    @property
+    def dof(self) -> int:
+        return self.spline.n
+
+    @property
+    def path_interval(self) -> np.ndarray:
+        return np.array([0.0, 1.0])
+
+    @property
+    def waypoints(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.spline.breaks, self.spline.values(self.spline.breaks)[0]
+
+
+def toppra_profile(motion: Any) -> Trajectory:
+    """TOPP-RA's s(t) (toppra's ParametrizeConstAccel `motion`: constant s̈ between its grid points) as a chain
+    trajectory: s, ṡ, s̈ in the Samples' q, qd, qdd (m, 1); torques unset (zero)."""
+    times = motion._ts  # the grid points' times; toppra keeps them on the parametrizer
+
+    def profile(t: np.ndarray) -> Samples:
+        t = np.clip(np.asarray(t, dtype=float), times[0], times[-1])
+        s, sd, sdd = motion._eval_params(t)
+        zeros = np.zeros((len(t), 1))
+        return Samples(t, s[:, None], sd[:, None], sdd[:, None], zeros, zeros)
+
+    return Trajectory(profile(times), profile)
+
+
+class TimedPath(NamedTuple):
+    """The timing of one path: the refined solve, the set-up of its build (s), how it started, TOPP-RA's t_f (s;
+    NaN without a TOPP-RA profile)."""
+
+    refined: Refined
+    setup_time: float
+    start: str
+    toppra_tf: float
+
+
+def time_path(problem: Problem, smooth: PathSpline, transcription: str = "chebyshev", knots: int = 12,
+              dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt", refinements: int = DEFAULT_ROUNDS,
+              transcription_options: dict | None = None, solver_options: dict | None = None,
+              dynamics_options: dict | None = None, max_wall_time: float = 60.0, grid_points: int = 1000
+              ) -> TimedPath:
+    """The optimal timing of the fixed path `smooth` (from problem.start to problem.goal) under `problem`'s limits
+    and cost (the module docstring's step 3; options as for `plan_ompl_topp3`)."""
+    path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
+    timed = _time_optimal(problem, ToppraPath(path), grid_points)
+    ocp = PathTimingOCP(problem.robot, path)
+    made = build(problem, transcription, knots, dynamics, solver, TIMING_CONSTRAINTS, transcription_options,
+                 solver_options, dynamics_options, ocp=ocp)
+    discretization = made.discretization.with_ocp(ocp)
+    if timed is None:
+        w, start, toppra_tf = discretization.initial_guess(problem), "from s at constant speed (no TOPP-RA profile)", \
+            np.nan
+    else:
+        w, start, toppra_tf = discretization.encode(toppra_profile(timed[0])), "from TOPP-RA's profile", \
+            float(timed[1][-1])
+    refined = solve_refined(discretization, made.solver, problem, w, refinements,
+                            time.perf_counter() + max_wall_time)
+    return TimedPath(refined, made.setup_time, start, toppra_tf)
+
+
+def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
+                    dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt",
+                    refinements: int = DEFAULT_ROUNDS, transcription_options: dict | None = None,
+                    solver_options: dict | None = None, dynamics_options: dict | None = None,
+                    max_wall_time: float = 60.0, planner_name: str = "rrtconnect", planning_time: float = 1.0,
+                    seed: int = 0, resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01) -> Plan:
+    """Plan `problem` by OMPL path, quintic smoothing and optimal timing along the path (module docstring).
+
+    The timing OCP's options are `plan_simultaneous`'s (`transcription`, `knots`, `dynamics`, `solver`,
+    `refinements`, their option dicts; `max_wall_time` (s) bounds its solves); the path's are `plan_ompl_toppra`'s
+    (`planner_name`, `planning_time`, `seed`, `resolution`, `margin`; `grid_points` for the TOPP-RA warm start).
+
+    Status: the solver's when it did not converge, else "verified" or "violated"; "no_path" (OMPL found no exact
+    path) holds the start."""
+    check_ompl_planner(planner_name)
+    began = time.perf_counter()
+    method = {"planner": "ompl-topp3", "path_planner": planner_name, "transcription": transcription, "knots": knots,
+              "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": solver}
+    if np.array_equal(problem.start, problem.goal):
+        return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
+    setup = _import_backends()
+    free = planning_space(problem, margin)
+    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution)
+    extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "margin_m": free.margin}
+    if found.waypoints is None:
+        return finish(problem, _hold(problem), "no_path", method, began, setup_time=setup, extra=extra, found=False,
+                      message=f"{planner_name}: no exact path within {planning_time:g} s; the plan holds the start")
+    smooth, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
+    timing = time_path(problem, smooth, transcription, knots, dynamics, solver, refinements, transcription_options,
+                       solver_options, dynamics_options, max_wall_time, grid_points)
+    refined, result = timing.refined, timing.refined.result
+    extra.update(waypoints=len(found.waypoints), repair_rounds=rounds, toppra_tf_s=timing.toppra_tf)
+    stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
+    message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; timing {timing.start}: "
+               f"{result.message}")
+    return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + timing.setup_time,
+                  iterations=refined.iterations, rounds=refined.rounds, message=message, extra=extra,
+                  verification=refined.verification)
