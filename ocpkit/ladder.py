@@ -32,8 +32,10 @@ OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path (a
 @dataclass(frozen=True)
 class Rung:
     """Option overrides of one attempt: `guess` ("line", "ompl" or None for the call's), OMPL `seed`, `knots`
-    and pseudospectral `segments` (None: the call's), and `max_iterations` per solve (None: the solver's). An
-    "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's time is up."""
+    and pseudospectral `segments` (None: the call's), `max_iterations` per solve (None: the solver's), and
+    `relaxed`: a continuation, solving the problem relaxed (ocpkit.refine.RELAXED) first to warm-start the real
+    one. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's time
+    is up."""
 
     name: str
     guess: str | None = None
@@ -41,6 +43,7 @@ class Rung:
     knots: int | None = None
     segments: int | None = None
     max_iterations: int | None = None
+    relaxed: bool = False
 
 
 DEFAULT_LADDER: tuple[Rung, ...] = (
@@ -48,6 +51,7 @@ DEFAULT_LADDER: tuple[Rung, ...] = (
     Rung("ompl-0", guess="ompl", seed=0, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("ompl-1", guess="ompl", seed=1, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("relaxed-first", relaxed=True, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("first-uncapped"),
 )
 """The default ladder (module docstring says why each rung is there)."""

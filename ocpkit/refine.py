@@ -32,6 +32,8 @@ MIN_MARGIN_STEP = 0.005  # m
 PENETRATION_FACTOR = 2.0
 LIMIT_BACKOFF = 0.005  # fraction of each limit
 MIN_SHRINK = 0.5  # one round never takes more than half of a limit away
+RELAXED = Refinement(extra_margin=-0.02, limit_scale=1.5)  # a continuation's first problem: the clearance
+# margin 2 cm smaller (spheres may touch) and half as much again of every velocity, torque and torque-rate limit
 NAMED_PARTS = ("tf", "q", "qd", "qdd", "u", "s", "sd", "sdd")  # parts of w named in out-of-bounds messages
 
 
@@ -65,10 +67,16 @@ def margin_step(penetration: float) -> float:
 
 
 def solve_refined(discretization: Discretization, solver: PreparedSolver, problem: Problem, guess: np.ndarray,
-                  rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf) -> Refined:
+                  rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf, relaxed: Refinement | None = None) -> Refined:
     """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds, all
-    before `deadline` (time.perf_counter s)."""
+    before `deadline` (time.perf_counter s). With `relaxed` (continuation), a first solve of the problem
+    relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status."""
     refinement, iterations, taken = Refinement(), 0, 0
+    if relaxed is not None:
+        bounds = discretization.bounds(problem, relaxed)
+        easier = solver.solve(guess, discretization.parameters(problem, relaxed), bounds,
+                              max_wall_time=max(deadline - time.perf_counter(), 0.0))
+        guess, iterations = np.clip(easier.w, *discretization.bounds(problem, refinement)), easier.iterations
     while True:
         bounds = discretization.bounds(problem, refinement)
         result = solver.solve(guess, discretization.parameters(problem, refinement), bounds,

@@ -20,7 +20,7 @@ from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
-from ocpkit.refine import DEFAULT_ROUNDS, solve_refined
+from ocpkit.refine import DEFAULT_ROUNDS, RELAXED, solve_refined
 from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization
 
@@ -77,6 +77,8 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
         changed["transcription_options"] = {**options["transcription_options"], "segments": rung.segments}
     if rung.max_iterations is not None:
         changed["solver_options"] = {"max_iterations": rung.max_iterations, **options["solver_options"]}
+    if rung.relaxed:
+        changed["relaxed"] = True
     return changed
 
 
@@ -98,7 +100,8 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
         line = made.discretization.decode(line_guess(problem, made.discretization))
         return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
                       message=f"guess {options['guess']!r}: {exc}; not solved")
-    refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline)
+    refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline,
+                            RELAXED if options.get("relaxed") else None)
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=made.setup_time,

@@ -5,9 +5,23 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import ocpkit
+from helpers import REPO
+from ocpkit.build_cache import build
 from ocpkit.nlp import Refinement
-from ocpkit.refine import LIMIT_BACKOFF, MIN_MARGIN_STEP, MIN_SHRINK, PENETRATION_FACTOR, margin_step, next_refinement
+from ocpkit.refine import (
+    LIMIT_BACKOFF,
+    MIN_MARGIN_STEP,
+    MIN_SHRINK,
+    PENETRATION_FACTOR,
+    RELAXED,
+    margin_step,
+    next_refinement,
+    solve_refined,
+)
 from ocpkit.verify import Check, Verification
+
+CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
 
 
 def verification(times=(0.3, 0.1), **worst) -> Verification:
@@ -71,3 +85,29 @@ def test_margin_step_is_zero_without_contact():
 def test_a_large_limit_excess_shrinks_the_limits_by_at_most_min_shrink():
     following = next_refinement(Refinement(), verification(torque=1.2), 1.0)  # torque 120 % over its limit
     assert following.limit_scale == MIN_SHRINK
+
+
+class Spy:
+    """A prepared solver that records the parameters and guess of every solve and passes it on."""
+
+    def __init__(self, solver) -> None:
+        self.solver, self.calls = solver, []
+
+    def solve(self, guess, parameters, bounds, max_wall_time=None):
+        self.calls.append((np.array(guess), np.array(parameters)))
+        return self.solver.solve(guess, parameters, bounds, max_wall_time=max_wall_time)
+
+
+@pytest.mark.slow
+def test_a_continuation_solves_the_relaxed_problem_first_and_starts_the_real_one_there():
+    made = build(CASE2, knots=8)
+    discretization, spy = made.discretization, Spy(made.solver)
+    w = discretization.initial_guess(CASE2)
+    refined = solve_refined(discretization, spy, CASE2, w, relaxed=RELAXED)
+    p = discretization.nlp.parameters
+    (first_guess, relaxed), (second_guess, real) = spy.calls[:2]
+    np.testing.assert_array_equal(first_guess, w)
+    assert p.read(relaxed, "limit_scale") == RELAXED.limit_scale and p.read(real, "limit_scale") == 1.0
+    assert p.read(relaxed, "margin") == pytest.approx(p.read(real, "margin") + RELAXED.extra_margin)
+    assert not np.array_equal(second_guess, w)  # warm-started from the relaxed solution
+    assert refined.verification.ok and refined.iterations > 0
