@@ -7,14 +7,17 @@ iterations in `stats.extra["rungs"]`. A rung that only lifts the iteration cap o
 (listed in `stats.extra["skipped"]`) unless that one stopped at its cap: it would repeat the same solve. An
 empty ladder plans once with the call's options (the paper's single shot).
 
-Why these rungs (tuned on `ocpkit bench random --seed 200 --count 40 --obstacles 1 3`: 33 of 40 verified, the
-other 7 with no OMPL path; measured on seed 300 in README.md): the straight line verifies most
-problems within a few hundred IPOPT iterations, and one that has not converged by then usually ends infeasible
-or at the iteration limit after many seconds, so the first rung is capped (MAX_ITERATIONS_CAPPED); the OMPL +
-TOPP-RA motion (collision-free by construction) is the better start in clutter, and another seed gives another
-homotopy class when the first one is poor; more knots resolve what a coarse grid leaves violated; the last rung
-is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single shot finds
-in time.
+Why these rungs (tuned on `ocpkit bench random --seed 200 --count 40 --obstacles 1 3` and seed 300; measured
+on seed 500 in README.md): the straight line verifies most problems within a few hundred IPOPT iterations, and
+one that has not converged by then usually ends infeasible or at the iteration limit after many seconds, so the
+first rung is capped (MAX_ITERATIONS_CAPPED): that cap is how the ladder leaves a local infeasibility, a
+restoration phase or a t_f pinned at its upper bound early. The OMPL + TOPP-RA motion (collision-free by
+construction) is the better start in clutter, and another seed gives another homotopy class when the first one
+is poor; its path search is budgeted in configurations checked (OMPL_CHECKS, the budget the random suite
+certifies room to pass with), so whether it finds a path does not depend on the machine's speed. More knots
+resolve what a coarse grid leaves violated. The continuation rung solves the problem relaxed first (a softened
+margin, wider limits) and the real one from there. The last rung is the uncapped single shot with whatever time
+is left, so the ladder never loses a plan the single shot finds in time.
 """
 
 from __future__ import annotations
