@@ -107,7 +107,11 @@ def _bench_command(args: argparse.Namespace) -> int:
         return run_command(args, check_writable)
     out = Path(args.out or f"results/{args.suite}")
     check_writable(out, folder=True)
-    if args.suite == "convergence":
+    if args.suite == "perf":
+        from ocpkit.bench.perf import run_perf
+
+        run_perf(Path(args.scenarios), out, repeats=args.repeats or 5, quick=args.quick)
+    elif args.suite == "convergence":
         from ocpkit.bench.convergence import DEFAULT_CASE, run_convergence
 
         run_convergence(out, case=Path(args.case or DEFAULT_CASE))
@@ -228,7 +232,7 @@ def parser() -> argparse.ArgumentParser:
                    "when interrupted)")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite", epilog=exit_codes)
-    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "run"],
+    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "run", "perf"],
                    help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
                    "solvers: every NLP solver x dynamics backend on the paper cases; random: seeded random "
                    "industrial6 problems with obstacles in the way; run: a suite file (scenarios x methods x repeats)")
@@ -260,6 +264,7 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--single-shot", action="store_true", help="random: plan without the fallback ladder (the "
                    "paper's one solve; bench paper always plans so)")
     add_run_arguments(b)
+    b.add_argument("--quick", action="store_true", help="perf: 2 repeats and a short growth curve (for tests)")
     b.set_defaults(run=_bench_command)
     add_report_parser(commands)
     add_show_parser(commands)

@@ -92,18 +92,21 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     dynamics = options["dynamics"]
     method = {"planner": "simultaneous", "transcription": options["transcription"], "knots": options["knots"],
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options["solver"]}
+    guessing = time.perf_counter()
     try:
         w = _guess(problem, made.discretization, options["guess"], options["guess_options"])
     except NoGuess as exc:
         line = made.discretization.decode(line_guess(problem, made.discretization))
         return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
                       message=f"guess {options['guess']!r}: {exc}; not solved")
+    guess_time = time.perf_counter() - guessing
     refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline)
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=made.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
-                  verification=refined.verification)
+                  verification=refined.verification,
+                  extra={"timing": {"guess": guess_time, "rounds": list(refined.timing), "setup": made.setup_parts}})
 
 
 def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray, options: dict) -> np.ndarray:
