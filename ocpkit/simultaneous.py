@@ -16,6 +16,7 @@ from ocpkit.build_cache import build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
+from ocpkit.guesses import line_guess
 from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
@@ -23,12 +24,6 @@ from ocpkit.problem import Problem
 from ocpkit.refine import DEFAULT_ROUNDS, solve_refined
 from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization
-
-
-def line_guess(problem: Problem, discretization: Discretization, fallback: bool = True) -> np.ndarray:
-    """The straight joint-space line from start to goal over t_f = time.guess (the paper's initial guess); it always
-    exists, so `fallback` (every guess rule takes it: see NoGuess) changes nothing."""
-    return discretization.initial_guess(problem)
 
 
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
@@ -41,8 +36,9 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     """Plan `problem` with path and timing together.
 
     `knots` is N, the intervals per segment of a pseudospectral transcription (K N + 1 points on K `segments`) or
-    the mesh intervals of a local one; `guess` names a registered initial-guess rule ("line": the paper's straight
-    joint-space line; "ompl": the OMPL + TOPP-RA baseline's motion) or is a decision vector for this shape, with
+    the mesh intervals of a local one; `guess` names a registered initial-guess rule ("line", the default: the straight
+    joint-space line over an estimated motion time, ocpkit.guesses; "paper": the paper's line over t_f = time.guess;
+    "ompl": the OMPL + TOPP-RA baseline's motion) or is a decision vector for this shape, with
     `guess_options` for the rule (e.g. {"seed": 3, "planning_time": 2.0} for "ompl", the baseline's options);
     `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess is part of
     the computation time; the one-time set-up is not. `max_wall_time` (s) bounds the computation
