@@ -2,8 +2,9 @@
 
 Per plan of the paper cases at the paper's settings (chebyshev, 12 and 8 knots, single shot), the computation time
 split into: the solver's NLP evaluations by kind (CasADi's t_wall_nlp_f, _g, _grad_f, _jac_g, _hess_l), the
-solver's own work (IPOPT's call minus those callbacks: linear solves with MUMPS and the interior-point
-bookkeeping; CasADi does not time them apart), the iteration callback (Python), the solver call's wrapper,
+solver's own work (IPOPT's call minus those callbacks), split into linear solves (MUMPS) and the rest of IPOPT
+by the shares IPOPT's own timing statistics give on one extra plan per case (`ipopt_shares`), the iteration
+callback (Python), the solver call's wrapper,
 verification, the guess and the rest of Python; and by solve (the first, each refinement round). The one-time
 set-up split into graph construction (the transcription's build) and solver creation (nlpsol: CasADi generates
 and sparsity-analyses its derivative functions there; nothing is compiled to C, so compilation is 0). Medians and
@@ -15,11 +16,14 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import re
 import statistics
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from ocpkit.bench.common import load_all, machine
 from ocpkit.bench.paper import PAPER_SETUP
@@ -37,7 +41,8 @@ PAPER_COMPUTATION = {12: 2.47, 8: 1.30}
 """The paper's median computation time (s) at 12 and 8 knots."""
 KNOTS = (12, 8)
 EVALUATIONS = CALLBACKS[:5]
-PARTS = (*EVALUATIONS, "solver internal", "iteration callback", "solver wrapper", "verification", "guess", "python")
+PARTS = (*EVALUATIONS, "linear solves", "ipopt overhead", "iteration callback", "solver wrapper", "verification",
+         "guess", "python")
 """The parts of a plan's computation time, in the order printed (module docstring)."""
 GROWTH_KNOTS = (8, 12, 16, 24, 32)
 GROWTH_OBSTACLES = (1, 2, 4, 8, 16, 32)
@@ -61,14 +66,16 @@ class Sample:
     status: str
 
 
-def sample(result: Plan) -> Sample:
-    """The figures of one simultaneous plan from its stats (stats.extra["timing"], ocpkit.simultaneous)."""
+def sample(result: Plan, linear_share: float = 0.0) -> Sample:
+    """The figures of one simultaneous plan from its stats (stats.extra["timing"], ocpkit.simultaneous);
+    `linear_share`: the fraction of IPOPT's own work (its call less the callbacks) in linear solves."""
     timing = result.stats.extra.get("timing", {})
     rounds = timing.get("rounds", [])
     parts = {kind: sum(r.get(kind, 0.0) for r in rounds) for kind in EVALUATIONS}
     total = sum(r.get("total", r["solve"]) for r in rounds)
     parts["iteration callback"] = sum(r.get("callback_fun", 0.0) for r in rounds)
-    parts["solver internal"] = total - sum(parts[k] for k in EVALUATIONS) - parts["iteration callback"]
+    internal = total - sum(parts[k] for k in EVALUATIONS) - parts["iteration callback"]
+    parts["linear solves"], parts["ipopt overhead"] = linear_share * internal, (1 - linear_share) * internal
     parts["solver wrapper"] = sum(r["solve"] for r in rounds) - total
     parts["verification"] = sum(r["verify"] for r in rounds)
     parts["guess"] = timing.get("guess", 0.0)
@@ -77,12 +84,38 @@ def sample(result: Plan) -> Sample:
                   result.stats.setup_time, timing.get("setup", {}), result.stats.iterations, result.status)
 
 
-def planned(problem: Problem, knots: int, fresh: bool = False, **options) -> Sample:
+def planned(problem: Problem, knots: int, fresh: bool = False, linear_share: float = 0.0, **options) -> Sample:
     """One single-shot plan of `problem` at `knots` (options as for `ocpkit.plan`); `fresh`: with an empty build
-    cache, so that it includes the set-up."""
+    cache, so that it includes the set-up; `linear_share` as for `sample`."""
     if fresh:
         clear_builds()
-    return sample(plan(problem, knots=knots, fallbacks=SINGLE_SHOT, **options))
+    return sample(plan(problem, knots=knots, fallbacks=SINGLE_SHOT, **options), linear_share)
+
+
+def ipopt_timing(problem: Problem, knots: int) -> dict[str, float]:
+    """IPOPT's own timing statistics (wall s) of one plan: `total` (OverallAlgorithm), `linear`
+    (StdAugSystemSolverMultiSolve: factorizations and back-solves of the KKT system) and `evaluations`
+    (Function Evaluations), read from its output file (print_timing_statistics)."""
+    with tempfile.TemporaryDirectory() as folder:
+        log = Path(folder) / "ipopt.out"
+        plan(problem, knots=knots, fallbacks=SINGLE_SHOT, solver_options={
+            "output_file": str(log), "file_print_level": 3, "print_timing_statistics": "yes"})
+        text = log.read_text()
+    found = {key: re.findall(rf"^\s*{label}\.*:.*wall:\s*([0-9.]+)\)", text, re.MULTILINE)
+             for key, label in (("total", "OverallAlgorithm"), ("linear", "StdAugSystemSolverMultiSolve"),
+                                ("evaluations", "Function Evaluations"))}
+    return {key: float(values[-1]) if values else 0.0 for key, values in found.items()}
+
+
+def linear_share(timings: list[dict[str, float]]) -> float:
+    """Median over `timings` (ipopt_timing) of the linear solves' share of IPOPT's own work (total less
+    evaluations)."""
+    return statistics.median(min(t["linear"] / max(t["total"] - t["evaluations"], 1e-9), 1.0) for t in timings)
+
+
+def progress(items: list, label: str) -> tqdm:
+    """`items` with a progress bar on stderr (gone when done)."""
+    return tqdm(items, desc=label, unit="plan", leave=False)
 
 
 def p95(values: list[float]) -> float:
@@ -96,9 +129,10 @@ def paper_split(problems: list[Problem], repeats: int, knots: tuple[int, ...] = 
     out = {}
     for n in knots:
         samples = []
-        for p in problems:
-            first = planned(p, n, fresh=True)
-            repeated = [planned(p, n) for _ in range(repeats)]
+        share = linear_share([ipopt_timing(p, n) for p in problems])
+        for p in progress(problems, f"split at {n} knots"):
+            first = planned(p, n, fresh=True, linear_share=share)
+            repeated = [planned(p, n, linear_share=share) for _ in range(repeats)]
             samples += [dataclasses.replace(repeated[0], setup=first.setup, setup_parts=first.setup_parts),
                         *repeated[1:]]
         out[n] = samples
@@ -142,8 +176,8 @@ def split_table(split: dict[int, list[Sample]]) -> str:
                      f"{statistics.median(s.setup_parts.get('graph', 0) for s in setups):>7.2f}s"
                      f"{statistics.median(s.setup_parts.get('solver', 0) for s in setups):>7.2f}s{0:>8.2f}s"
                      f"{PAPER_SETUP:>6.1f}s")
-    lines.append("solver internal: IPOPT's own work (MUMPS linear solves + interior-point steps); set-up ratio to "
-                 f"the paper: {PAPER_SETUP:.1f} s / ours")
+    lines.append("linear solves / ipopt overhead: IPOPT's call less the callbacks, split by the share of "
+                 "StdAugSystemSolverMultiSolve in IPOPT's timing statistics (median of one extra plan per case)")
     return "\n".join(lines)
 
 
@@ -194,10 +228,10 @@ def fitted_exponent(x: list[float], y: list[float]) -> float:
 def growth(case: Problem, repeats: int, knots: tuple[int, ...], obstacles: tuple[int, ...]) -> list[dict]:
     """Rows (series, x, setup, computation, iterations, status): against knots, against obstacle spheres (12 knots),
     and the 6-joint case beside the 7-joint Panda (12 knots)."""
-    rows = [{"series": "knots", "x": n, **growth_point(case, n, repeats)} for n in knots]
-    rows += [{"series": "obstacles", "x": k, **growth_point(cluttered(case, k), 12, repeats)} for k in obstacles]
-    rows += [{"series": "joints", "x": p.robot.n, **growth_point(p, 12, repeats)} for p in (case, panda_problem())]
-    return rows
+    points = [("knots", n, case, n) for n in knots] + [("obstacles", k, cluttered(case, k), 12) for k in obstacles]
+    points += [("joints", p.robot.n, p, 12) for p in (case, panda_problem())]
+    return [{"series": series, "x": x, **growth_point(problem, n, repeats)}
+            for series, x, problem, n in progress(points, "growth")]
 
 
 def growth_table(rows: list[dict]) -> str:
@@ -209,13 +243,19 @@ def growth_table(rows: list[dict]) -> str:
     for series, exponents in exponents_by_series(rows).items():
         lines.append(f"fitted exponent against {series}: computation ~ x^{exponents['computation']:.2f}, "
                      f"set-up ~ x^{exponents['setup']:.2f}")
+    robots = [r for r in rows if r["series"] == "joints"]
+    if len(robots) == 2:
+        six, seven = robots
+        lines.append(f"{seven['x']} joints (panda) vs {six['x']} ({GROWTH_CASE}): computation "
+                     f"x{seven['computation'] / six['computation']:.1f}, set-up x{seven['setup'] / six['setup']:.1f}")
     return "\n".join(lines)
 
 
 def exponents_by_series(rows: list[dict]) -> dict[str, dict[str, float]]:
-    """The fitted power-law exponent of computation and set-up per series with at least two x values."""
+    """The fitted power-law exponent of computation and set-up against knots and obstacles (with at least two x
+    values each); two robots are compared by ratio instead."""
     out = {}
-    for series in dict.fromkeys(r["series"] for r in rows):
+    for series in ("knots", "obstacles"):
         chosen = [r for r in rows if r["series"] == series]
         if len({r["x"] for r in chosen}) > 1:
             x = [r["x"] for r in chosen]
@@ -237,7 +277,7 @@ def plot_growth(rows: list[dict], path: Path) -> None:
         chosen = [r for r in rows if r["series"] == series]
         x = [r["x"] for r in chosen]
         for key, marker in (("computation", "o-"), ("setup", "s--")):
-            fit = f" (~x^{fits[series][key]:.2f})" if series in fits and series != "joints" else ""
+            fit = f" (~x^{fits[series][key]:.2f})" if series in fits else ""
             ax.plot(x, [r[key] for r in chosen], marker, label=f"{key}{fit}")
         if series != "joints":
             ax.set_xscale("log")

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from helpers import REPO
 
-from ocpkit.bench.perf import EVALUATIONS, PARTS, cluttered, fitted_exponent, planned, run_perf
+from ocpkit.bench.perf import (EVALUATIONS, PARTS, cluttered, fitted_exponent, ipopt_timing, linear_share, planned,
+                               run_perf)
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.scenario import load_scenario
 
@@ -17,10 +18,15 @@ def test_split_adds_up_to_the_wall_time():
     first = planned(CASE2, 8, fresh=True)
     assert first.setup == pytest.approx(sum(first.setup_parts.values()), rel=0.01)
     assert first.setup_parts["graph"] > 0 and first.setup_parts["solver"] > 0
-    s = planned(CASE2, 8)  # the build reused, as in every timed repeat
+    timing = ipopt_timing(CASE2, 8)
+    assert 0 < timing["linear"] < timing["total"] and 0 < timing["evaluations"] < timing["total"]
+    share = linear_share([timing])
+    assert 0 < share < 1
+    s = planned(CASE2, 8, linear_share=share)  # the build reused, as in every timed repeat
     assert s.status == "verified" and s.setup == 0
+    assert s.parts["linear solves"] / (s.parts["linear solves"] + s.parts["ipopt overhead"]) == pytest.approx(share)
     assert set(s.parts) == set(PARTS)
-    assert all(s.parts[p] > 0 for p in (*EVALUATIONS[1:], "solver internal", "verification"))
+    assert all(s.parts[p] > 0 for p in (*EVALUATIONS[1:], "linear solves", "ipopt overhead", "verification"))
     # every measured part is a real interval inside the plan: the unaccounted Python rest is small and not negative
     assert -1e-3 <= s.parts["python"] <= 0.2 * s.computation + 0.01
     assert sum(s.solves) <= s.computation + 1e-6
