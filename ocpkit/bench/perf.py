@@ -123,16 +123,17 @@ def p95(values: list[float]) -> float:
     return float(np.percentile(values, 95))
 
 
-def paper_split(problems: list[Problem], repeats: int, knots: tuple[int, ...] = KNOTS) -> dict[int, list[Sample]]:
-    """Per knot count, `repeats` plans of each problem after one that builds (its set-up kept as the first
-    sample's), in one list."""
+def paper_split(problems: list[Problem], repeats: int, knots: tuple[int, ...] = KNOTS,
+                guess: str = "line") -> dict[int, list[Sample]]:
+    """Per knot count, `repeats` plans of each problem from `guess` after one that builds (its set-up kept as the
+    first sample's), in one list."""
     out = {}
     for n in knots:
         samples = []
         share = linear_share([ipopt_timing(p, n) for p in problems])
-        for p in progress(problems, f"split at {n} knots"):
-            first = planned(p, n, fresh=True, linear_share=share)
-            repeated = [planned(p, n, linear_share=share) for _ in range(repeats)]
+        for p in progress(problems, f"{guess} guess, {n} knots"):
+            first = planned(p, n, fresh=True, linear_share=share, guess=guess)
+            repeated = [planned(p, n, linear_share=share, guess=guess) for _ in range(repeats)]
             samples += [dataclasses.replace(repeated[0], setup=first.setup, setup_parts=first.setup_parts),
                         *repeated[1:]]
         out[n] = samples
@@ -161,24 +162,35 @@ def split_table(split: dict[int, list[Sample]]) -> str:
             values = [value(s) for s in samples]
             cells += f"{statistics.median(values) * 1e3:>16.1f}ms{p95(values) * 1e3:>7.1f}ms{'':>7}"
         lines.append(f"{label:<22}{cells}")
-    lines.append("")
-    lines.append(f"{'knots':>6}{'computation':>13}{'p95':>8}{'paper':>8}{'speed-up':>10}{'iterations':>12}"
-                 f"{'verified':>10}{'set-up':>9}{'graph':>8}{'solver':>8}{'compile':>9}{'paper':>7}")
-    for n, samples in split.items():
-        setups = [s for s in samples if s.setup > 0]
-        median = medians[n]
-        paper = PAPER_COMPUTATION.get(n)
-        lines.append(f"{n:>6}{median:>12.3f}s{p95([s.computation for s in samples]):>7.3f}s"
-                     f"{(f'{paper:.2f}s' if paper else '-'):>8}{(f'{paper / median:.1f}x' if paper else '-'):>10}"
-                     f"{statistics.median(s.iterations for s in samples):>12.0f}"
-                     f"{sum(s.status == 'verified' for s in samples):>6}/{len(samples):<3}"
-                     f"{statistics.median(s.setup for s in setups):>8.2f}s"
-                     f"{statistics.median(s.setup_parts.get('graph', 0) for s in setups):>7.2f}s"
-                     f"{statistics.median(s.setup_parts.get('solver', 0) for s in setups):>7.2f}s{0:>8.2f}s"
-                     f"{PAPER_SETUP:>6.1f}s")
     lines.append("linear solves / ipopt overhead: IPOPT's call less the callbacks, split by the share of "
                  "StdAugSystemSolverMultiSolve in IPOPT's timing statistics (median of one extra plan per case)")
     return "\n".join(lines)
+
+
+def summary_table(splits: dict[str, dict[int, list[Sample]]]) -> str:
+    """Per guess and knot count: median and p95 computation, the paper's figure and the ratio, iterations (median
+    per plan), verified plans, set-up and its split (medians over the fresh builds), the paper's set-up."""
+    lines = ["", f"{'guess':<7}{'knots':>6}{'computation':>13}{'p95':>8}{'paper':>8}{'speed-up':>10}{'iterations':>12}"
+             f"{'verified':>10}{'set-up':>9}{'graph':>8}{'solver':>8}{'compile':>9}{'paper':>7}"]
+    for guess, split in splits.items():
+        lines += [f"{guess:<7}" + _summary_row(n, samples) for n, samples in split.items()]
+    lines.append("line: the default guess (ocpkit.guesses); paper: the paper's (straight line over t_f = 10 s); "
+                 "compile: nothing is compiled to C")
+    return "\n".join(lines)
+
+
+def _summary_row(n: int, samples: list[Sample]) -> str:
+    setups = [s for s in samples if s.setup > 0]
+    median = statistics.median(s.computation for s in samples)
+    paper = PAPER_COMPUTATION.get(n)
+    return (f"{n:>6}{median:>12.3f}s{p95([s.computation for s in samples]):>7.3f}s"
+            f"{(f'{paper:.2f}s' if paper else '-'):>8}{(f'{paper / median:.1f}x' if paper else '-'):>10}"
+            f"{statistics.median(s.iterations for s in samples):>12.0f}"
+            f"{sum(s.status == 'verified' for s in samples):>6}/{len(samples):<3}"
+            f"{statistics.median(s.setup for s in setups):>8.2f}s"
+            f"{statistics.median(s.setup_parts.get('graph', 0) for s in setups):>7.2f}s"
+            f"{statistics.median(s.setup_parts.get('solver', 0) for s in setups):>7.2f}s{0:>8.2f}s"
+            f"{PAPER_SETUP:>6.1f}s")
 
 
 def cluttered(problem: Problem, count: int, seed: int = CLUTTER_SEED) -> Problem:
@@ -314,6 +326,7 @@ def run_perf(scenarios: Path, out: Path, repeats: int = 5, quick: bool = False) 
     repeats = 2 if quick else repeats
     split = paper_split(problems, repeats)
     print(split_table(split), flush=True)
+    print(summary_table({"line": split, "paper": paper_split(problems, repeats, guess="paper")}), flush=True)
     write_split_csv(out / "split.csv", split)
     case = next((p for p in problems if p.name == GROWTH_CASE), problems[0])
     rows = growth(case, 1 if quick else 3, GROWTH_KNOTS[:2] if quick else GROWTH_KNOTS,
