@@ -235,8 +235,8 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "run", "perf"],
                    help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
                    "solvers: every NLP solver x dynamics backend on the paper cases; random: seeded random "
-                   "industrial6 problems with obstacles in the way; run: a suite file (scenarios x methods x repeats); perf: "
-                   "where a paper plan's time goes, and growth with knots, obstacles and joints")
+                   "industrial6 problems with obstacles in the way; run: a suite file (scenarios x methods x repeats); "
+                   "perf: where a paper plan's time goes, and growth with knots, obstacles and joints")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml (default "
                    "scenarios/paper, relative to the current folder)")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
