@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
@@ -28,12 +28,14 @@ CACHE_SIZE = 32
 
 @dataclass(frozen=True)
 class Build:
-    """A Discretization, a solver prepared for its NLP, and the seconds its set-up took (0 when it came from the
-    cache)."""
+    """A Discretization, a solver prepared for its NLP, the seconds its set-up took (0 when it came from the
+    cache) and their split: `setup_parts` {"graph": the transcription's build, "solver": the solver's prepare}
+    (s, empty when cached)."""
 
     discretization: Discretization
     solver: PreparedSolver
     setup_time: float
+    setup_parts: dict = field(default_factory=dict)
 
 
 _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
@@ -58,8 +60,10 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
         return Build(_BUILDS[key].discretization, _BUILDS[key].solver, 0.0)
     began = time.perf_counter()
     discretization = method.build(problem, backend, plugins, ocp)
+    built = time.perf_counter()
     prepared = nlp_solver.prepare(discretization.nlp)
-    _BUILDS[key] = Build(discretization, prepared, time.perf_counter() - began)
+    ended = time.perf_counter()
+    _BUILDS[key] = Build(discretization, prepared, ended - began, {"graph": built - began, "solver": ended - built})
     while len(_BUILDS) > CACHE_SIZE:
         _BUILDS.popitem(last=False)
     return _BUILDS[key]

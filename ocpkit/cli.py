@@ -108,7 +108,11 @@ def _bench_command(args: argparse.Namespace) -> int:
         return run_command(args, check_writable)
     out = Path(args.out or f"results/{args.suite}")
     check_writable(out, folder=True)
-    if args.suite == "convergence":
+    if args.suite == "perf":
+        from ocpkit.bench.perf import run_perf
+
+        run_perf(Path(args.scenarios), out, repeats=args.repeats or 5, quick=args.quick)
+    elif args.suite == "convergence":
         from ocpkit.bench.convergence import DEFAULT_CASE, run_convergence
 
         run_convergence(out, case=Path(args.case or DEFAULT_CASE))
@@ -219,7 +223,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--segments", type=int, help="pseudospectral segments K (chebyshev, lgl, lgr; default 1)")
     p.add_argument("--dynamics", help=f"dynamics backend: {_names(DYNAMICS)} (default casadi-rnea)")
     p.add_argument("--solver", help=f"NLP solver: {_names(SOLVERS)} (default ipopt)")
-    p.add_argument("--guess", help=f"initial guess: {_names(GUESSES)} (default line)")
+    p.add_argument("--guess", help=f"initial guess: {_names(GUESSES)} (default paper)")
     p.add_argument("--refinements", type=int, help="at most this many re-solve rounds after verification (default 5)")
     p.add_argument("--seed", type=int, help="OMPL's random seed (default 0): of ompl-toppra, or of the simultaneous "
                    "planner's --guess ompl")
@@ -233,12 +237,12 @@ def parser() -> argparse.ArgumentParser:
                    "when interrupted)")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite", epilog=exit_codes)
-    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "shapes", "run"],
+    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "shapes", "run", "perf"],
                    help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
                    "solvers: every NLP solver x dynamics backend on the paper cases; random: seeded random "
                    "industrial6 problems with obstacles in the way; shapes: what boxes and cylinders cost "
                    "(scenarios/shapes/boxes.yaml with and without them); run: a suite file (scenarios x methods x "
-                   "repeats)")
+                   "repeats); perf: where a paper plan's time goes, and growth with knots, obstacles and joints")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml (default "
                    "scenarios/paper, relative to the current folder)")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
@@ -268,6 +272,7 @@ def parser() -> argparse.ArgumentParser:
                    "paper's one solve; bench paper always plans so)")
     b.add_argument("--planner", default="simultaneous", help="random: the planner (default simultaneous)")
     add_run_arguments(b)
+    b.add_argument("--quick", action="store_true", help="perf: 2 repeats and a short growth curve (for tests)")
     b.set_defaults(run=_bench_command)
     add_report_parser(commands)
     add_show_parser(commands)

@@ -33,6 +33,37 @@ def sphere_centers(robot: Robot, q: np.ndarray, data: pin.Data | None = None) ->
     return out[0] if np.ndim(q) == 1 else out
 
 
+AXES = {"X": 0, "Y": 1, "Z": 2}
+"""The joint axis of pinocchio's aligned 1-DoF joints (JointModelRX ... JointModelPZ), by the name's last letter."""
+
+
+def sphere_centers_batch(robot: Robot, qs: np.ndarray) -> np.ndarray:
+    """`sphere_centers` of many configurations qs (K, n) at once, shape (K, M, 3): the joint poses composed in
+    numpy over all K together (revolute and prismatic 1-DoF joints, the ones ocpkit models), instead of one
+    pinocchio forward-kinematics call per configuration; the same numbers (tests/test_geometry.py)."""
+    model, qs = robot.model, np.atleast_2d(np.asarray(qs, dtype=float))
+    rotation = np.empty((model.njoints, len(qs), 3, 3))
+    translation = np.empty((model.njoints, len(qs), 3))
+    rotation[0], translation[0] = np.eye(3), 0.0
+    for j in range(1, model.njoints):
+        joint, placement, parent = model.joints[j], model.jointPlacements[j], model.parents[j]
+        kind = joint.shortname()
+        axis = joint.extract().axis if kind.endswith("Unaligned") else np.eye(3)[AXES[kind[-1]]]
+        q = qs[:, joint.idx_q]
+        local_r = np.broadcast_to(placement.rotation, (len(qs), 3, 3))
+        local_t = np.broadcast_to(placement.translation, (len(qs), 3))
+        if kind.startswith("JointModelR"):  # Rodrigues: R(q) = I + sin q [a]x + (1 − cos q) [a]x²
+            cross = np.cross(np.eye(3), axis)
+            turn = np.eye(3) + np.sin(q)[:, None, None] * cross + (1 - np.cos(q))[:, None, None] * (cross @ cross)
+            local_r = local_r @ turn
+        else:
+            local_t = local_t + np.einsum("ij,j->i", placement.rotation, axis) * q[:, None]
+        rotation[j] = rotation[parent] @ local_r
+        translation[j] = translation[parent] + np.einsum("kij,kj->ki", rotation[parent], local_t)
+    r, t = rotation[robot.sphere_joint], translation[robot.sphere_joint]  # (M, K, 3, 3), (M, K, 3)
+    return (np.einsum("mkij,mj->kmi", r, robot.sphere_offset) + t.transpose(1, 0, 2))
+
+
 @dataclass(frozen=True)
 class Clearances:
     """Signed clearances (m) for K configurations: self (K, P), obstacle (K, M, S + B + C: spheres, boxes,

@@ -37,16 +37,30 @@ RELAXED = Refinement(extra_margin=-0.02, limit_scale=1.5)  # a continuation's fi
 NAMED_PARTS = ("tf", "q", "qd", "qdd", "u", "s", "sd", "sdd")  # parts of w named in out-of-bounds messages
 
 
+CALLBACKS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l", "callback_fun", "total")
+"""What a CasADi solver's stats time (t_wall_<kind>): the NLP function and derivative evaluations by kind, the
+iteration callback (Python), and the whole solver call."""
+
+
 @dataclass(frozen=True)
 class Refined:
-    """The last solve's result, its trajectory and verification, the iterations of all solves, and the
-    refinement rounds taken."""
+    """The last solve's result, its trajectory and verification, the iterations of all solves, the
+    refinement rounds taken, and per solve (first, then each round) where its time went (`round_timing`)."""
 
     result: SolverResult
     trajectory: Trajectory
     verification: Verification
     iterations: int
     rounds: int
+    timing: tuple[dict, ...] = ()
+
+
+def round_timing(result: SolverResult, verify_time: float) -> dict:
+    """Seconds of one solve: `solve` (the solver call's wall time), `verify`, and the solver's own wall time per
+    NLP evaluation kind (CALLBACKS, from its stats, where it reports them); `iterations`."""
+    stats = result.stats or {}
+    callbacks = {kind: float(stats[f"t_wall_{kind}"]) for kind in CALLBACKS if f"t_wall_{kind}" in stats}
+    return {"solve": result.wall_time, "verify": verify_time, "iterations": result.iterations, **callbacks}
 
 
 def next_refinement(previous: Refinement, verification: Verification, tf: float) -> Refinement | None:
@@ -71,12 +85,13 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
     """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds, all
     before `deadline` (time.perf_counter s). With `relaxed` (continuation), a first solve of the problem
     relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status."""
-    refinement, iterations, taken = Refinement(), 0, 0
+    refinement, iterations, taken, timing = Refinement(), 0, 0, []
     if relaxed is not None:
         bounds = discretization.bounds(problem, relaxed)
         easier = solver.solve(guess, discretization.parameters(problem, relaxed), bounds,
                               max_wall_time=max(deadline - time.perf_counter(), 0.0))
         guess, iterations = np.clip(easier.w, *discretization.bounds(problem, refinement)), easier.iterations
+        timing.append(round_timing(easier, 0.0))
     while True:
         bounds = discretization.bounds(problem, refinement)
         result = solver.solve(guess, discretization.parameters(problem, refinement), bounds,
@@ -84,13 +99,15 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         result = checked(result, discretization.nlp.variables, bounds)
         iterations += result.iterations
         trajectory = discretization.decode(result.w)
+        verified = time.perf_counter()
         verification = verify(problem, trajectory)
+        timing.append(round_timing(result, time.perf_counter() - verified))
         following = next_refinement(refinement, verification, trajectory.tf)
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
                                          message=f"wall-time limit reached before refinement round {taken + 1}")
         if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds:
-            return Refined(result, trajectory, verification, iterations, taken)
+            return Refined(result, trajectory, verification, iterations, taken, tuple(timing))
         refinement, guess, taken = following, result.w, taken + 1
 
 

@@ -16,6 +16,7 @@ from ocpkit.build_cache import build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
+from ocpkit.guesses import line_guess
 from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
@@ -25,14 +26,9 @@ from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization
 
 
-def line_guess(problem: Problem, discretization: Discretization, fallback: bool = True) -> np.ndarray:
-    """The straight joint-space line from start to goal over t_f = time.guess (the paper's initial guess); it always
-    exists, so `fallback` (every guess rule takes it: see NoGuess) changes nothing."""
-    return discretization.initial_guess(problem)
-
-
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
-                      dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt", guess: str | np.ndarray = "line",
+                      dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt",
+                      guess: str | np.ndarray = "paper",
                       refinements: int = DEFAULT_ROUNDS,
                       constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
                       transcription_options: dict | None = None, solver_options: dict | None = None,
@@ -41,8 +37,10 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     """Plan `problem` with path and timing together.
 
     `knots` is N, the intervals per segment of a pseudospectral transcription (K N + 1 points on K `segments`) or
-    the mesh intervals of a local one; `guess` names a registered initial-guess rule ("line": the paper's straight
-    joint-space line; "ompl": the OMPL + TOPP-RA baseline's motion) or is a decision vector for this shape, with
+    the mesh intervals of a local one; `guess` names a registered initial-guess rule ("paper", the default: the
+    paper's line over t_f = time.guess; "line": the straight joint-space line over an estimated motion time,
+    ocpkit.guesses;
+    "ompl": the OMPL + TOPP-RA baseline's motion) or is a decision vector for this shape, with
     `guess_options` for the rule (e.g. {"seed": 3, "planning_time": 2.0} for "ompl", the baseline's options);
     `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess is part of
     the computation time; the one-time set-up is not. `max_wall_time` (s) bounds the computation
@@ -94,19 +92,22 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     dynamics = options["dynamics"]
     method = {"planner": "simultaneous", "transcription": options["transcription"], "knots": options["knots"],
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options["solver"]}
+    guessing = time.perf_counter()
     try:
         w = _guess(problem, made.discretization, options["guess"], options["guess_options"])
     except NoGuess as exc:
         line = made.discretization.decode(line_guess(problem, made.discretization))
         return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
                       message=f"guess {options['guess']!r}: {exc}; not solved")
+    guess_time = time.perf_counter() - guessing
     refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline,
                             RELAXED if options.get("relaxed") else None)
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=made.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
-                  verification=refined.verification)
+                  verification=refined.verification,
+                  extra={"timing": {"guess": guess_time, "rounds": list(refined.timing), "setup": made.setup_parts}})
 
 
 def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray, options: dict) -> np.ndarray:

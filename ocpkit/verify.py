@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.geometry import clearances, sphere_centers_batch
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
 from ocpkit.trajectory import TIME_TOLERANCE, Samples, Trajectory, time_excess
@@ -104,7 +104,7 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
         "torque_rate": np.abs(samples.taud) / robot.taud_max - 1.0,
     }
     consistency = np.abs(samples.tau - tau_needed) / (2.0 * robot.tau_max)
-    c = clearances(robot, problem.scene, sphere_centers(robot, samples.q))
+    c = clearances(robot, problem.scene, sphere_centers_batch(robot, samples.q))
     penetration = dict(zip(GEOMETRY_CHECKS, (-c.self_pairs, -c.obstacles, -c.workspace)))
     checks = [_worst(name, v, LIMIT_TOLERANCE, samples.t, "rel") for name, v in excess.items()]
     checks.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))

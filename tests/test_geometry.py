@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 import pytest
 import yaml
 
 import ocpkit
+import ocpkit.geometry
 from ocpkit.geometry import Clearances, clearances, collision_report, sphere_centers
 from ocpkit.robots.robot import DATA_DIR
 from ocpkit.scene import Scene, Workspace
@@ -118,3 +121,23 @@ def test_collision_report_names_self_contacts_and_workspace_faces():
     low_ceiling = Workspace(np.array([-3.0, -3.0, -1.0]), np.array([3.0, 3.0, 0.5]))
     lines = collision_report(ROBOT, Scene(workspace=low_ceiling), HOME)
     assert lines and all("leaves the workspace at z max" in line for line in lines)
+
+
+@pytest.mark.parametrize("name", ["industrial6", "panda"])
+def test_batched_sphere_centres_match_pinocchio_per_configuration(name):
+    robot = ocpkit.load_robot(name)
+    qs = RNG.uniform(robot.q_lower, robot.q_upper, (50, robot.n))
+    np.testing.assert_allclose(ocpkit.geometry.sphere_centers_batch(robot, qs), sphere_centers(robot, qs),
+                               atol=1e-12)
+
+
+def test_batched_sphere_centres_of_prismatic_joints_match_pinocchio():
+    model = pin.Model()
+    tilted = pin.SE3(pin.rpy.rpyToMatrix(0.3, -0.2, 0.5), np.array([0.1, 0.2, 0.3]))
+    a = model.addJoint(0, pin.JointModelPY(), tilted, "slide")
+    b = model.addJoint(a, pin.JointModelPrismaticUnaligned(np.array([0.6, 0.0, 0.8])), tilted, "slide2")
+    c = model.addJoint(b, pin.JointModelRevoluteUnaligned(np.array([0.0, 0.6, 0.8])), tilted, "turn")
+    robot = dataclasses.replace(ROBOT, model=model, sphere_joint=np.array([a, b, c, c]),
+                                 sphere_offset=RNG.normal(size=(4, 3)))
+    qs = RNG.uniform(-1, 1, (20, 3))
+    np.testing.assert_allclose(ocpkit.geometry.sphere_centers_batch(robot, qs), sphere_centers(robot, qs), atol=1e-12)

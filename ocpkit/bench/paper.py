@@ -27,7 +27,7 @@ from ocpkit.bench.common import (
 from ocpkit.ladder import SINGLE_SHOT
 from ocpkit.plan import Plan
 from ocpkit.problem import Problem
-from ocpkit.report import Recorded, result_row, row_key, trajectory_header
+from ocpkit.report import KEY_COLUMNS, RESULT_COLUMNS, Recorded, result_row, row_key, trajectory_header
 from ocpkit.trajectory import write_json
 
 PAPER_TF = {12: [1.65, 1.23, 1.05, 1.08], 8: [1.98, 1.23, 1.09, 1.11]}
@@ -35,6 +35,11 @@ PAPER_SOLVE = {12: [2.55, 2.37, 2.39, 2.57], 8: [1.28, 1.75, 0.84, 1.32]}
 PAPER_SETUP = 5.9
 KNOTS = (12, 8)
 WIDTH = 24
+PAPER_GUESS, TIMED_GUESS = "paper", "line"
+"""The paper's initial guess (its table's rows) and the planner's default, run beside it."""
+COLUMNS = (*RESULT_COLUMNS, "guess")
+"""results.csv of the paper bench: the result columns and the simultaneous planner's initial guess ('' for the
+baseline), which is part of a row's key."""
 
 
 def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
@@ -49,13 +54,15 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
     Each row is added to results.csv as its plan finishes; rows already there (suite, case and method) are not
     run again, so a run stopped by Ctrl-C resumes where it stopped. The tables show every row, earlier or new."""
     problems = load_all(Path(scenarios))
-    results = Results(Path(out) / "results.csv")
+    results = Results(Path(out) / "results.csv", COLUMNS, (*KEY_COLUMNS, "guess"))
     if results.resumed:
         print(resumed_line(results), flush=True)
     bench = _Bench(results, Path(out), repeats, transcription, transcription_options or {})
     with reported_on_interrupt(results):
         simultaneous = {(form, p.name, n): bench.simultaneous("paper", p, n, form, write=form == dynamics[0])
                         for form in dynamics for n in knots for p in problems}
+        default = {(p.name, n): bench.simultaneous("paper", p, n, dynamics[0], guess=TIMED_GUESS)
+                   for n in knots for p in problems}
         baseline = {p.name: bench.baseline(p) for p in problems}
         topp3 = {p.name: bench.topp3(p, knots[0], dynamics[0]) for p in problems}
         matched = {p.name: bench.simultaneous("matched-to-baseline", p, knots[0], dynamics[0], repeats=1)
@@ -65,6 +72,7 @@ def run_paper_benchmark(scenarios: Path, out: Path, repeats: int = 5,
     options = "".join(f" {k}={v}" for k, v in bench.options.items())
     print(_paper_table(problems, first, f"{transcription}{options} + ipopt, dynamics {dynamics[0]}", knots))
     print(_comparison(problems, simultaneous, dynamics, knots))
+    print(_guess_table(problems, first, default, knots))
     print(_baseline_table(problems, {c: m for (c, k), m in first.items() if k == knots[0]}, baseline, matched))
     print(_same_limits_table(problems, {c: m for (c, k), m in first.items() if k == knots[0]}, baseline, topp3))
     if hard is not None:
@@ -87,17 +95,17 @@ class _Bench:
     def simultaneous(self, suite: str, problem: Problem, knots: int, dynamics: str, write: bool = False,
                      repeats: int | None = None, **options) -> Recorded:
         """The simultaneous planner's row for `problem` at `knots` with `dynamics` (and `options`), single shot
-        (no fallback ladder), as in the paper."""
+        (no fallback ladder) from the paper's guess unless `options` name another, as in the paper."""
         method = {"planner": "simultaneous", "transcription": self.transcription, "knots": knots, "solver": "ipopt",
                   "dynamics": dynamics}
         return self._row(suite, problem, method, write, self.repeats if repeats is None else repeats,
                          transcription=self.transcription, transcription_options=self.options, knots=knots,
-                         dynamics=dynamics, fallbacks=SINGLE_SHOT, **options)
+                         dynamics=dynamics, fallbacks=SINGLE_SHOT, **{"guess": PAPER_GUESS, **options})
 
     def seeding(self, problems: list[Problem], knots: int, dynamics: str) -> dict[tuple[str, str], Recorded]:
         """The straight-line and the OMPL guess on each of `problems`, one run each, by (case, guess)."""
         return {(p.name, guess): self.simultaneous(f"seeding-{guess}", p, knots, dynamics, repeats=1, guess=guess)
-                for p in problems for guess in ("line", "ompl")}
+                for p in problems for guess in ("paper", "ompl")}
 
     def baseline(self, problem: Problem) -> Recorded:
         """The OMPL + TOPP-RA baseline's row for `problem`."""
@@ -117,9 +125,11 @@ class _Bench:
             m = measure(problem, repeats, **options)
             if write:
                 _write_trajectory(self.out, problem, m.plan)
-            return result_row(suite, problem.name, m.plan, m.solve_time, m.setup_time)
+            return {**result_row(suite, problem.name, m.plan, m.solve_time, m.setup_time), "guess": guess}
 
-        return Recorded.of(self.results.row(row_key({"suite": suite, "case": problem.name, **method}), measured))
+        guess = options.get("guess", "")
+        key = row_key({"suite": suite, "case": problem.name, **method, "guess": guess}, self.results.key_columns)
+        return Recorded.of(self.results.row(key, measured))
 
 
 def _matched_to_baseline(problems: list[Problem]) -> list[Problem]:
@@ -172,6 +182,20 @@ def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ..
             verified = sum(m.ok for m in cases)
             lines.append(f"{form:<14}{knots:>6}{median:>19.3f}s{speedup:>10}{setup:>8.2f}s{PAPER_SETUP:>13.1f}s"
                          f"{verified:>8}/{len(cases)}")
+    return "\n".join(lines)
+
+
+def _guess_table(problems: list[Problem], paper: dict, default: dict, counts: tuple[int, ...]) -> str:
+    """The paper's guess (straight line, t_f = time.guess) beside the timed line (ocpkit.guesses) per knot count."""
+    lines = ["", f"Initial guess: the paper's ({PAPER_GUESS}: straight line over t_f = time.guess) vs the timed line "
+             f"({TIMED_GUESS}: straight line over a velocity/torque estimate of t_f), single shot",
+             f"{'guess':<8}{'knots':>6}{'median computation':>20}{'iterations':>12}{'per case':>18}{'verified':>10}"]
+    for label, measured in ((PAPER_GUESS, paper), (TIMED_GUESS, default)):
+        for knots in counts:
+            cases = [measured[p.name, knots] for p in problems]
+            lines.append(f"{label:<8}{knots:>6}{statistics.median(m.solve_time for m in cases):>19.3f}s"
+                         f"{sum(m.iterations for m in cases):>12}{' '.join(str(m.iterations) for m in cases):>18}"
+                         f"{sum(m.ok for m in cases):>8}/{len(cases)}")
     return "\n".join(lines)
 
 

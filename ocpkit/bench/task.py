@@ -55,7 +55,7 @@ def _guess_and_seed(planner: str, options: dict, seed: int | None, rung_name: st
     if planner != "simultaneous":
         return "", seed
     rung = next((r for r in options.get("fallbacks", DEFAULT_LADDER) if r.name == rung_name), None)
-    guess = (rung.guess if rung else None) or options.get("guess", "line")
+    guess = (rung.guess if rung else None) or options.get("guess", "paper")
     if rung is not None and rung.guess is not None:
         seed = rung.seed if guess == "ompl" else None
     return guess, seed

@@ -172,7 +172,7 @@ class CasadiNlpsol(Solver):
 
     def prepare(self, nlp: NLP) -> PreparedNlpsol:
         problem = {"x": nlp.x, "p": nlp.p, "f": nlp.f, "g": nlp.g}
-        options = {"print_time": False, "error_on_fail": False, **self.plugin_options(nlp)}
+        options = {"print_time": False, "record_time": True, "error_on_fail": False, **self.plugin_options(nlp)}
         deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel()) if self.stops_by_callback else None
         if deadline is not None:
             options["iteration_callback"] = deadline

@@ -15,7 +15,7 @@ import pytest
 from helpers import REPO
 
 from ocpkit.bench.common import Results
-from ocpkit.report import RESULT_COLUMNS, row_key
+from ocpkit.report import KEY_COLUMNS, RESULT_COLUMNS, row_key
 
 ROW = {**dict.fromkeys(RESULT_COLUMNS, ""), "suite": "paper", "case": "case1", "planner": "simultaneous",
        "knots": 12, "status": "verified", "tf": 1.5, "extra": "{}"}
@@ -67,15 +67,18 @@ def test_ctrl_c_keeps_finished_rows_and_a_rerun_completes_each_row_once(tmp_path
     assert process.returncode == 130, stdout + stderr
     assert stderr.splitlines() == ["interrupted"]
     kept = file_rows(out / "results.csv")
-    assert 1 <= len(kept) < 6 and f"interrupted: {len(kept)} finished rows kept in {out / 'results.csv'}" in stdout
+    assert 1 <= len(kept) < 8 and f"interrupted: {len(kept)} finished rows kept in {out / 'results.csv'}" in stdout
 
     rerun = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
     assert rerun.returncode == 0, rerun.stderr
     assert f"resuming: {len(kept)} rows already in" in rerun.stdout
     rows = file_rows(out / "results.csv")
     assert rows[:len(kept)] == kept
-    keys = [row_key(r) for r in rows]
-    assert len(keys) == len(set(keys)) == 7  # 4 simultaneous (2 dynamics x 2 knot counts), 2 baselines, matched
+    keys = [row_key(r, (*KEY_COLUMNS, "guess")) for r in rows]
+    # 4 simultaneous (2 dynamics x 2 knot counts), 2 from the default guess, 2 baselines, matched
+    assert len(keys) == len(set(keys)) == 9
+    assert sorted(r["guess"] for r in rows) == ["", "", "line", "line", "paper", "paper", "paper", "paper", "paper"]
+    assert "Initial guess: the paper's" in rerun.stdout
     assert "motion time t_f" in rerun.stdout and "ratio sim / baseline" in rerun.stdout
     assert f"results: {out / 'results.csv'}" in rerun.stdout
 

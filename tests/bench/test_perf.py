@@ -1,0 +1,56 @@
+"""`ocpkit bench perf`: the split of a plan's computation time adds up, and its growth problems are sound."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers import REPO
+
+from ocpkit.bench.perf import (EVALUATIONS, PARTS, cluttered, fitted_exponent, ipopt_timing, linear_share, planned,
+                               run_perf)
+from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.scenario import load_scenario
+
+CASE2 = load_scenario(REPO / "scenarios/paper/case2.yaml")
+
+
+def test_split_adds_up_to_the_wall_time():
+    first = planned(CASE2, 8, fresh=True)
+    assert first.setup == pytest.approx(sum(first.setup_parts.values()), rel=0.01)
+    assert first.setup_parts["graph"] > 0 and first.setup_parts["solver"] > 0
+    timing = ipopt_timing(CASE2, 8)
+    assert 0 < timing["linear"] < timing["total"] and 0 < timing["evaluations"] < timing["total"]
+    share = linear_share([timing])
+    assert 0 < share < 1
+    s = planned(CASE2, 8, linear_share=share)  # the build reused, as in every timed repeat
+    assert s.status == "verified" and s.setup == 0
+    assert s.parts["linear solves"] / (s.parts["linear solves"] + s.parts["ipopt overhead"]) == pytest.approx(share)
+    assert set(s.parts) == set(PARTS)
+    assert all(s.parts[p] > 0 for p in (*EVALUATIONS[1:], "linear solves", "ipopt overhead", "verification"))
+    # every measured part is a real interval inside the plan: the unaccounted Python rest is small and not negative
+    assert -1e-3 <= s.parts["python"] <= 0.2 * s.computation + 0.01
+    assert sum(s.solves) <= s.computation + 1e-6
+
+
+def test_cluttered_adds_spheres_clear_of_the_straight_line():
+    busy = cluttered(CASE2, 6)
+    assert busy.scene.n_obstacles == 6
+    np.testing.assert_array_equal(busy.scene.obstacle_centers[0], CASE2.scene.obstacle_centers[0])
+    line = CASE2.start + np.linspace(0, 1, 41)[:, None] * (CASE2.goal - CASE2.start)
+    extra = type(busy.scene)(busy.scene.obstacle_centers[1:], busy.scene.obstacle_radii[1:])
+    assert clearances(CASE2.robot, extra, sphere_centers(CASE2.robot, line)).obstacles.min() >= 0.1 - 1e-9
+    np.testing.assert_array_equal(cluttered(CASE2, 6).scene.obstacle_centers, busy.scene.obstacle_centers)  # seeded
+
+
+def test_fitted_exponent_recovers_a_power_law():
+    x = [8, 12, 16, 24, 32]
+    assert fitted_exponent(x, [3.0 * v**2.4 for v in x]) == pytest.approx(2.4)
+
+
+@pytest.mark.slow
+def test_perf_quick_writes_split_growth_and_png(tmp_path, capsys):
+    split = run_perf(REPO / "scenarios/paper", tmp_path, quick=True)
+    assert all(s.status == "verified" for samples in split.values() for s in samples)
+    assert (tmp_path / "growth.png").stat().st_size > 10_000
+    assert len((tmp_path / "split.csv").read_text().splitlines()) == 1 + 2 * 4 * 2
+    assert "fitted exponent against knots" in capsys.readouterr().out
