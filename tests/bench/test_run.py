@@ -58,7 +58,7 @@ def test_serial_run_writes_one_row_per_scenario_method_and_repeat_and_every_traj
                                                             for p in ("simultaneous", "ompl-toppra")}
     assert {r["scene"] for r in serial} == {"paper"} and {r["robot"] for r in serial} == {"industrial6"}
     sim = [r for r in serial if r["planner"] == "simultaneous"]
-    assert all(r["status"] == "verified" and r["guess"] == "line" and r["seed"] == "" for r in sim)
+    assert all(r["status"] == "verified" and r["guess"] == "paper" and r["seed"] == "" for r in sim)
     assert all(r["seed"] == "0" for r in serial if r["planner"] == "ompl-toppra")
     assert all(0 < float(r["peak_torque_use"]) <= 1.01 for r in sim)
 
@@ -223,7 +223,7 @@ def test_the_paper_suite_gives_the_same_rows_with_jobs_2_on_a_local_cluster_and_
 def test_the_guess_and_seed_columns_follow_the_fallback_rung_that_gave_the_plan():
     from ocpkit.bench.task import _guess_and_seed
 
-    assert _guess_and_seed("simultaneous", {}, None, "first") == ("line", None)
+    assert _guess_and_seed("simultaneous", {}, None, "first") == ("paper", None)
     assert _guess_and_seed("simultaneous", {}, None, "ompl-1") == ("ompl", 1)
     assert _guess_and_seed("simultaneous", {"guess": "ompl", "fallbacks": ()}, 4, None) == ("ompl", 4)
     assert _guess_and_seed("ompl-toppra", {"seed": 2}, 2, None) == ("", 2)
