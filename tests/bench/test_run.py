@@ -142,7 +142,7 @@ def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_p
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [3, 1]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     suite = load_suite(tmp_path / "suites/s.yaml")
-    assert [(s.scene, s.case) for s in suite.scenarios] == [("cage", "problem10"), ("cage", "problem1")]
+    assert [(s.scene, s.case) for s in suite.scenarios] == [("panda-cage", "problem10"), ("panda-cage", "problem1")]
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [4]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     with pytest.raises(SuiteError, match=r"problems\[0\]: problem 4 does not exist"):
