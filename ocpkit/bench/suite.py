@@ -199,7 +199,8 @@ def _mbm(body: dict, base: Path, where: str) -> list[Scenario]:
             if number > len(files):
                 raise SuiteError(f"{where}.problems[{k}]: problem {number} does not exist: {folder} has "
                                  f"{len(files)} problems")
-        scenarios += [_from_file(files[number - 1], scene) for number in numbers]
+        label = f"{body['robot']}-{scene}"  # robots share scene names
+        scenarios += [_from_file(files[number - 1], label) for number in numbers]
     return scenarios
 
 

@@ -124,7 +124,8 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uni
     ("scenarios: [{random: {count: 2, obstacles: [3, 1]}}]\nmethods: [{planner: simultaneous}]",
      "scenarios[0].random.obstacles needs [min, max]"),
 ])
-def test_a_bad_suite_is_an_error_naming_the_field(tmp_path, text, message):
+def test_a_bad_suite_is_an_error_naming_the_field(tmp_path, monkeypatch, text, message):
+    monkeypatch.setattr("ocpkit.bench.suite.MBM_CACHE", tmp_path / "cache")  # no MBM cache, whatever this machine has
     shutil.copy(REPO / "scenarios/paper/case1.yaml", tmp_path / "a.yaml")
     (tmp_path / "suite.yaml").write_text(text)
     with pytest.raises(SuiteError) as error:
@@ -142,7 +143,7 @@ def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_p
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [3, 1]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     suite = load_suite(tmp_path / "suites/s.yaml")
-    assert [(s.scene, s.case) for s in suite.scenarios] == [("cage", "problem10"), ("cage", "problem1")]
+    assert [(s.scene, s.case) for s in suite.scenarios] == [("panda-cage", "problem10"), ("panda-cage", "problem1")]
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [4]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     with pytest.raises(SuiteError, match=r"problems\[0\]: problem 4 does not exist"):
