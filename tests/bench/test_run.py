@@ -142,7 +142,7 @@ def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_p
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [3, 1]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     suite = load_suite(tmp_path / "suites/s.yaml")
-    assert [(s.scene, s.case) for s in suite.scenarios] == [("cage", "problem10"), ("cage", "problem1")]
+    assert [(s.scene, s.case) for s in suite.scenarios] == [("panda/cage", "problem10"), ("panda/cage", "problem1")]
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [4]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     with pytest.raises(SuiteError, match=r"problems\[0\]: problem 4 does not exist"):
@@ -159,15 +159,14 @@ def test_random_source_and_repeats_give_seeded_problems_and_seeds(tmp_path):
 
 
 def test_the_shipped_suites_are_well_formed():
-    from ocpkit.bench.suite import SUITE
-    from ocpkit.schema import check, read_yaml
-
     paper = load_suite(REPO / "suites/paper.yaml")
     assert [s.case for s in paper.scenarios] == ["case1", "case2", "case3", "case4"]
     assert [m.label for m in paper.methods] == ["simultaneous", "ompl-toppra"] and paper.repeats == 3
-    mbm = read_yaml((REPO / "suites/mbm-small.yaml").read_bytes(), SuiteError)
-    check(mbm, SUITE, SuiteError)  # the MBM subset and ompl-topp3 come with their own branches
-    assert [m["planner"] for m in mbm["methods"]] == ["simultaneous", "ompl-topp3", "ompl-toppra"]
+    mbm = load_suite(REPO / "suites/mbm-small.yaml")
+    scenes = ["bookshelf_small", "bookshelf_tall", "bookshelf_thin", "box", "cage", "table_pick", "table_under_pick"]
+    assert [(s.scene, s.case) for s in mbm.scenarios] == [(f"{robot}/{scene}", f"{scene}_0001")
+                                                          for robot in ("panda", "ur5") for scene in scenes]
+    assert [m.planner for m in mbm.methods] == ["simultaneous", "ompl-topp3", "ompl-toppra"]
 
 
 def test_an_out_folder_of_another_command_or_suite_is_refused_not_overwritten(tmp_path, capsys):
