@@ -56,7 +56,7 @@ METHOD = Mapping(
               "dynamics": String(), "guess": String(), "refinements": Number("non-negative", integer=True),
               "max_wall_time": Number("positive"), "single_shot": Choice((True, False)),
               "seed": Number("non-negative", integer=True), "planner_name": String(),
-              "planning_time": Number("positive"), "label": String()},
+              "planning_time": Number("positive"), "max_checks": _INTEGER, "label": String()},
 )
 """One method of the grid: a planner and its options (`label` names it in tables; default: planner + options)."""
 SOURCE = Tagged({
