@@ -57,7 +57,7 @@ def serve(motion: Motion, shapes: list[Shape], workspace: Workspace | None, host
     lower, upper = (workspace.lower, workspace.upper) if workspace is not None else scene_bounds(motion, shapes)
     middle, extent = (upper + lower) / 2, float(np.max(upper - lower))
     server.initial_camera.look_at = tuple(middle)
-    server.initial_camera.position = tuple(middle + extent * np.array([0.78, -1.09, 0.63]))
+    server.initial_camera.position = tuple(middle + extent * np.array([0.6, -0.85, 0.5]))
     spheres = [server.scene.add_icosphere(f"/robot/{j}", radius=float(r), color=ROBOT_COLOR,
                                           position=tuple(motion.centers[0, j])) for j, r in enumerate(motion.radii)]
     timeline = server.gui.add_slider("t [s]", min=0.0, max=float(motion.t[-1]), step=float(motion.t[1] - motion.t[0])
