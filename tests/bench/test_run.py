@@ -226,3 +226,21 @@ def test_the_guess_and_seed_columns_follow_the_fallback_rung_that_gave_the_plan(
     assert _guess_and_seed("simultaneous", {}, None, "ompl-1") == ("ompl", 1)
     assert _guess_and_seed("simultaneous", {"guess": "ompl", "fallbacks": ()}, 4, None) == ("ompl", 4)
     assert _guess_and_seed("ompl-toppra", {"seed": 2}, 2, None) == ("", 2)
+
+
+def test_a_planner_that_raises_gives_a_failed_row_naming_the_exception_not_a_crashed_run(monkeypatch):
+    import json
+
+    import ocpkit.bench.task as task_module
+    from ocpkit.bench.task import make_task, run_task
+
+    def broken(problem, **options):
+        raise ZeroDivisionError("a planner bug")
+
+    monkeypatch.setattr(task_module, "plan", broken)
+    suite = load_suite(REPO / "suites/paper.yaml")
+    outcome = run_task(make_task("paper", suite.scenarios[0], suite.methods[1], 0))
+    row = outcome["row"]
+    assert row["status"] == "failed" and row["method"] == "ompl-toppra"
+    assert json.loads(row["extra"])["error"] == "ompl-toppra raised ZeroDivisionError: a planner bug"
+    assert json.loads(outcome["trajectory"])["status"] == "failed"
