@@ -124,7 +124,8 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uni
     ("scenarios: [{random: {count: 2, obstacles: [3, 1]}}]\nmethods: [{planner: simultaneous}]",
      "scenarios[0].random.obstacles needs [min, max]"),
 ])
-def test_a_bad_suite_is_an_error_naming_the_field(tmp_path, text, message):
+def test_a_bad_suite_is_an_error_naming_the_field(tmp_path, monkeypatch, text, message):
+    monkeypatch.setattr("ocpkit.bench.suite.MBM_CACHE", tmp_path / "no-cache")  # not this machine's `data mbm`
     shutil.copy(REPO / "scenarios/paper/case1.yaml", tmp_path / "a.yaml")
     (tmp_path / "suite.yaml").write_text(text)
     with pytest.raises(SuiteError) as error:
