@@ -36,7 +36,11 @@ class PathSpline:
     @classmethod
     def fit(cls, chord: np.ndarray, waypoints: np.ndarray) -> PathSpline:
         """The natural quintic through `waypoints` (k, n) at increasing chord lengths `chord` (k,), rad
-        (p‴ = p⁗ = 0 at both ends)."""
+        (p‴ = p⁗ = 0 at both ends). Through two waypoints it is the straight line (their midpoint is added: the
+        end conditions alone leave a single quintic piece undetermined)."""
+        if len(waypoints) == 2:
+            chord = np.insert(chord, 1, chord.mean())
+            waypoints = np.insert(waypoints, 1, waypoints.mean(axis=0), axis=0)
         length = float(chord[-1])
         s = chord / length
         zero = np.zeros(waypoints.shape[1])

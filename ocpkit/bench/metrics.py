@@ -1,7 +1,7 @@
 """The figures the motion-planning benchmarks report (robometrics, cuRobo), per plan and per group of rows.
 
 Per plan, from the dense samples: joint-space path length (rad, Σ‖Δq‖₂), end-effector path length (m, of the
-last joint's frame origin), peak torque and torque-rate use (max over time and joints of |τ|/τ_max and
+tool frame: `end_effector_frame`), peak torque and torque-rate use (max over time and joints of |τ|/τ_max and
 |τ̇|/τ̇_max; 1 is the limit). Per group (a method, or a method on a scene): runs, success (= verified) rate, and
 over the verified runs the computation time's mean, median, 75th and 98th percentile, motion time t_f, the path
 lengths and the peak uses (medians).
@@ -19,13 +19,30 @@ PLAN_METRICS = ("path_length_rad", "ee_path_length_m", "peak_torque_use", "peak_
 """The per-plan columns of a `bench run` results.csv (empty when the planner found no trajectory)."""
 
 
+TOOL_FRAME_SUFFIXES = ("_tcp", "tool0", "flange", "ee_link")
+"""Names of tool frames, by preference (panda_hand_tcp, UR's tool0, industrial6's flange, ee_link)."""
+
+
+def end_effector_frame(robot: Robot) -> int:
+    """The pinocchio frame id of the end effector: the first body frame rigidly attached to the last joint whose
+    name ends in one of TOOL_FRAME_SUFFIXES (in that order), else the last joint's own frame."""
+    model = robot.model
+    last = model.njoints - 1
+    bodies = [k for k, f in enumerate(model.frames) if f.parentJoint == last and f.type == pin.FrameType.BODY]
+    for suffix in TOOL_FRAME_SUFFIXES:
+        match = next((k for k in bodies if model.frames[k].name.endswith(suffix)), None)
+        if match is not None:
+            return match
+    return model.getFrameId(model.names[last])
+
+
 def end_effector_positions(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """World position (m) of the last joint's frame origin at configurations q (K, n): shape (K, 3)."""
-    data = robot.model.createData()
+    """World position (m) of the end-effector frame (`end_effector_frame`) at configurations q (K, n): (K, 3)."""
+    data, frame = robot.model.createData(), end_effector_frame(robot)
     out = np.empty((len(q), 3))
     for k, qk in enumerate(q):
-        pin.forwardKinematics(robot.model, data, qk)
-        out[k] = data.oMi[robot.model.njoints - 1].translation
+        pin.framesForwardKinematics(robot.model, data, qk)
+        out[k] = data.oMf[frame].translation
     return out
 
 

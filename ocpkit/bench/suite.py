@@ -10,7 +10,8 @@ Scenario sources:
 - `mbm`: `{robot, scenes, problems}`: the MotionBenchMaker problems converted to scenario files, looked up in
   `scenarios/mbm/<robot>/<scene>/` next to the suite file or in its parent folder (the shipped subset), then in
   the cache folder of `ocpkit data mbm` (MBM_CACHE). Problem k (1-based) is the k-th file of the scene folder in
-  natural order (problem2 before problem10); all of them when `problems` is left out.
+  natural order (problem2 before problem10); all of them when `problems` is left out. Their scene is ROBOT/SCENE
+  (e.g. panda/cage: both robots have the same scenes and problem names).
 - `random`: `{robot: industrial6, count, seed, obstacles: [min, max]}`: ocpkit.bench.random.random_problems.
 """
 
@@ -55,7 +56,7 @@ METHOD = Mapping(
               "dynamics": String(), "guess": String(), "refinements": Number("non-negative", integer=True),
               "max_wall_time": Number("positive"), "single_shot": Choice((True, False)),
               "seed": Number("non-negative", integer=True), "planner_name": String(),
-              "planning_time": Number("positive"), "label": String()},
+              "planning_time": Number("positive"), "max_checks": _INTEGER, "label": String()},
 )
 """One method of the grid: a planner and its options (`label` names it in tables; default: planner + options)."""
 SOURCE = Tagged({
@@ -199,8 +200,7 @@ def _mbm(body: dict, base: Path, where: str) -> list[Scenario]:
             if number > len(files):
                 raise SuiteError(f"{where}.problems[{k}]: problem {number} does not exist: {folder} has "
                                  f"{len(files)} problems")
-        label = f"{body['robot']}-{scene}"  # robots share scene names
-        scenarios += [_from_file(files[number - 1], label) for number in numbers]
+        scenarios += [_from_file(files[number - 1], f"{body['robot']}/{scene}") for number in numbers]
     return scenarios
 
 

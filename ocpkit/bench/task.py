@@ -16,7 +16,9 @@ from pathlib import Path
 from ocpkit.bench.metrics import PLAN_METRICS, plan_metrics
 from ocpkit.bench.suite import Method, Scenario
 from ocpkit.ladder import DEFAULT_LADDER
+from ocpkit.plan import Plan, finish
 from ocpkit.planner import plan
+from ocpkit.problem import Problem
 from ocpkit.report import RESULT_COLUMNS, result_row, trajectory_header
 from ocpkit.scenario import problem_from_dict
 from ocpkit.trajectory import write_json
@@ -61,13 +63,27 @@ def _guess_and_seed(planner: str, options: dict, seed: int | None, rung_name: st
     return guess, seed
 
 
+def _plan_or_failed(problem: Problem, method: Method, options: dict) -> Plan:
+    """The method's plan; if the planner raises, a `failed` plan holding the start whose message names the
+    exception (also in the row's `extra`), so one task's crash ends its own row, not the whole run."""
+    started = time.perf_counter()
+    try:
+        return plan(problem, planner=method.planner, **options)
+    except Exception as exc:  # noqa: BLE001 - any planner bug becomes this row's status
+        from ocpkit.baselines.ompl_toppra import _hold
+
+        error = f"{method.planner} raised {type(exc).__name__}: {exc}"
+        return finish(problem, _hold(problem), "failed", {"planner": method.planner}, started, message=error,
+                      extra={"error": error}, found=False)
+
+
 def run_task(task: dict) -> dict:
     """Plan the task; return {"row": the results row (RUN_COLUMNS), "trajectory": the trajectory JSON text}."""
     started = time.perf_counter()
     problem = problem_from_dict(task["scenario"], name=task["case"])
     method = Method(**task["method"])
     options, seed = method.plan_options(task["repeat"])
-    result = plan(problem, planner=method.planner, **options)
+    result = _plan_or_failed(problem, method, options)
     wall = time.perf_counter() - started
     row = result_row(task["suite"], task["case"], result, result.stats.solve_time, result.stats.setup_time)
     metrics = plan_metrics(problem.robot, result.trajectory.sample()) if result.found else dict.fromkeys(

@@ -7,16 +7,40 @@ import threading
 import time
 
 import numpy as np
+import pinocchio as pin
 import viser
 
 from ocpkit.scene import Workspace
-from ocpkit.viewer.motion import OBSTACLE_COLOR, ROBOT_COLOR, WORKSPACE_COLOR, Motion, Shape, box_edges
+from ocpkit.viewer.motion import (
+    OBSTACLE_COLOR,
+    ROBOT_COLOR,
+    WORKSPACE_COLOR,
+    Motion,
+    Shape,
+    box_edges,
+    scene_bounds,
+)
+
+OPACITY = 0.6
+
+
+def wxyz(rotation: np.ndarray) -> tuple[float, float, float, float]:
+    """The unit quaternion (w, x, y, z), viser's order, of a rotation matrix (3, 3)."""
+    x, y, z, w = pin.Quaternion(np.asarray(rotation, dtype=float)).coeffs()
+    return float(w), float(x), float(y), float(z)
+
 
 DRAW = {
-    "sphere": lambda server, name, p: server.scene.add_icosphere(name, radius=p["radius"], color=OBSTACLE_COLOR,
-                                                                 position=tuple(p["center"]), opacity=0.6),
+    "sphere": lambda scene, name, p: scene.add_icosphere(name, radius=p["radius"], color=OBSTACLE_COLOR,
+                                                         position=tuple(p["center"]), opacity=OPACITY),
+    "box": lambda scene, name, p: scene.add_box(name, color=OBSTACLE_COLOR, dimensions=tuple(p["size"]),
+                                                wxyz=wxyz(p["rotation"]), position=tuple(p["center"]),
+                                                opacity=OPACITY),
+    "cylinder": lambda scene, name, p: scene.add_cylinder(name, radius=p["radius"], height=p["length"],
+                                                          color=OBSTACLE_COLOR, wxyz=wxyz(p["rotation"]),
+                                                          position=tuple(p["center"]), opacity=OPACITY),
 }
-"""How each obstacle kind is drawn in viser."""
+"""How each obstacle kind is drawn on a viser scene (viser's cylinders, like ours, lie along their local z)."""
 
 
 def serve(motion: Motion, shapes: list[Shape], workspace: Workspace | None, host: str = "127.0.0.1",
@@ -26,13 +50,14 @@ def serve(motion: Motion, shapes: list[Shape], workspace: Workspace | None, host
     server.scene.set_up_direction("+z")
     server.scene.add_grid("/ground", width=4.0, height=4.0, cell_size=0.25)
     for k, shape in enumerate(shapes):
-        DRAW[shape.kind](server, f"/obstacles/{k}", shape.parameters)
+        DRAW[shape.kind](server.scene, f"/obstacles/{k}", shape.parameters)
     if workspace is not None:
         server.scene.add_line_segments("/workspace", box_edges(workspace), WORKSPACE_COLOR, thickness=2.0,
                                        thickness_units="screen")
-        middle = (workspace.upper + workspace.lower) / 2
-        server.initial_camera.look_at = tuple(middle)
-        server.initial_camera.position = tuple(middle + np.array([2.5, -3.5, 2.0]))
+    lower, upper = (workspace.lower, workspace.upper) if workspace is not None else scene_bounds(motion, shapes)
+    middle, extent = (upper + lower) / 2, float(np.max(upper - lower))
+    server.initial_camera.look_at = tuple(middle)
+    server.initial_camera.position = tuple(middle + extent * np.array([0.6, -0.85, 0.5]))
     spheres = [server.scene.add_icosphere(f"/robot/{j}", radius=float(r), color=ROBOT_COLOR,
                                           position=tuple(motion.centers[0, j])) for j, r in enumerate(motion.radii)]
     timeline = server.gui.add_slider("t [s]", min=0.0, max=float(motion.t[-1]), step=float(motion.t[1] - motion.t[0])

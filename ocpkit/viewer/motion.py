@@ -25,7 +25,9 @@ WORKSPACE_COLOR = (120, 120, 120)
 
 @dataclass(frozen=True)
 class Shape:
-    """One obstacle: its `kind` ('sphere') and the kind's parameters (metres, world frame)."""
+    """One obstacle: its `kind` and the kind's parameters (metres, world frame): 'sphere' {center (3,), radius};
+    'box' {center (3,), size (3,) full edge lengths, rotation (3, 3) box → world}; 'cylinder' {center (3,), radius,
+    length (full, along its local z axis), rotation (3, 3) cylinder → world}."""
 
     kind: str
     parameters: dict
@@ -45,9 +47,34 @@ class Motion:
 
 
 def obstacle_shapes(scene: Scene) -> list[Shape]:
-    """The scene's obstacles as Shapes (spheres: center (3,), radius)."""
-    return [Shape("sphere", {"center": c, "radius": float(r)})
-            for c, r in zip(scene.obstacle_centers, scene.obstacle_radii)]
+    """The scene's obstacles as Shapes: spheres, then boxes, then cylinders (the Scene's order)."""
+    boxes, cylinders = scene.boxes, scene.cylinders
+    return ([Shape("sphere", {"center": c, "radius": float(r)})
+             for c, r in zip(scene.obstacle_centers, scene.obstacle_radii)]
+            + [Shape("box", {"center": c, "size": s, "rotation": R})
+               for c, s, R in zip(boxes.centers, boxes.sizes, boxes.rotations)]
+            + [Shape("cylinder", {"center": c, "radius": float(r), "length": float(h), "rotation": R})
+               for c, r, h, R in zip(cylinders.centers, cylinders.radii, cylinders.lengths, cylinders.rotations)])
+
+
+def box_corners(center: np.ndarray, size: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """The 8 corners (8, 3), m, of the box of full edge lengths `size` (3,) rotated by `rotation` (3, 3) about
+    `center` (3,); corner k has the signs of bits 2, 1, 0 of k on x, y, z (lower first)."""
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    return np.asarray(center) + (signs * np.asarray(size) / 2) @ np.asarray(rotation).T
+
+
+def scene_bounds(motion: Motion, shapes: list[Shape]) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corner (3,), m, of what there is to see: the robot's spheres over the motion and the
+    obstacles' bounding spheres."""
+    points = [motion.centers.reshape(-1, 3)]
+    for shape in shapes:
+        p = shape.parameters
+        reach = {"sphere": lambda: p["radius"], "box": lambda: np.linalg.norm(p["size"]) / 2,
+                 "cylinder": lambda: np.hypot(p["radius"], p["length"] / 2)}[shape.kind]()
+        points.append(np.asarray(p["center"]) + reach * np.array([[-1, -1, -1], [1, 1, 1]]))
+    points = np.concatenate(points)
+    return points.min(axis=0), points.max(axis=0)
 
 
 def load_motion(path: str | Path, problem: Problem, fps: float = 30.0) -> Motion:
@@ -75,6 +102,6 @@ def load_motion(path: str | Path, problem: Problem, fps: float = 30.0) -> Motion
 def box_edges(workspace: Workspace) -> np.ndarray:
     """The 12 edges of the workspace box as segment end points, shape (12, 2, 3), m."""
     lo, hi = workspace.lower, workspace.upper
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    corners = box_corners((lo + hi) / 2, hi - lo, np.eye(3))
     return np.array([(corners[a], corners[b]) for a in range(8) for b in range(a + 1, 8)
                      if np.count_nonzero(corners[a] != corners[b]) == 1])

@@ -86,6 +86,16 @@ def test_split_keeps_the_path(spline):
 
 
 
+def test_two_waypoints_give_the_straight_line():
+    """OMPL's simplified path is two waypoints when the straight line is free (MBM panda table_pick 1): the
+    natural quintic through them alone is not unique; the fit is the line."""
+    a, b = np.array([0.0, -0.5, 1.0]), np.array([1.2, 0.3, -0.4])
+    length = np.linalg.norm(b - a)
+    c = np.linspace(0.0, length, 9)
+    path = PathSpline.fit(np.array([0.0, length]), np.stack([a, b]))
+    assert path(c) == pytest.approx(a + np.outer(c / length, b - a), abs=1e-12)
+
+
 def test_path_timing_quantities_match_finite_differences_and_pinocchio(spline):
     """Along s(t) = smoothstep(t / T): q̇, q̈, q⃛ of the OCP against finite differences of q(t) = p(s(t)), and τ,
     dτ/dt against pinocchio's rnea + friction and its finite difference."""

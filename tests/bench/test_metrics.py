@@ -35,13 +35,27 @@ def test_a_base_rotation_gives_arc_lengths_and_the_limit_fractions():
     assert metrics["peak_torque_rate_use"] == pytest.approx(np.max(rate / robot.taud_max), rel=1e-3)
 
 
-def test_end_effector_positions_are_pinocchios_last_joint_origin():
-    robot = load_robot("industrial6")
+def test_end_effector_positions_are_pinocchios_last_joint_origin_for_a_flange_robot():
+    robot = load_robot("industrial6")  # its flange frame sits at the last joint's origin
     q = np.random.default_rng(0).uniform(-1, 1, (3, robot.n))
     data = robot.model.createData()
     for k, position in enumerate(end_effector_positions(robot, q)):
         pin.forwardKinematics(robot.model, data, q[k])
         assert np.allclose(position, data.oMi[robot.model.njoints - 1].translation)
+
+
+def test_the_panda_and_ur5_end_effectors_are_their_tool_points_at_the_zero_pose():
+    # Panda (Franka's DH table): flange at x = a7 = 0.088, z = d1 + d3 + d5 - d_F = 0.333 + 0.316 + 0.384 - 0.107,
+    # pointing down; the hand's TCP 0.1034 m below it.
+    panda = load_robot("panda")
+    assert end_effector_positions(panda, np.zeros((1, 7)))[0] == pytest.approx([0.088, 0.0, 0.926 - 0.1034], abs=1e-6)
+    # UR5 (UR's DH: d1 0.089159, a2 -0.425, a3 -0.39225, d4 0.10915, d5 0.09465, d6 0.0823): tool0 at the zero pose
+    # is (-(a2 + a3), d4 + d6, d1 - d5) in the URDF's base_link, which the spec yaws by 1.57 rad and lifts 0.9144 m.
+    ur5 = load_robot("ur5")
+    local = np.array([0.425 + 0.39225, 0.10915 + 0.0823, 0.089159 - 0.09465])
+    c, s = np.cos(1.57), np.sin(1.57)
+    world = np.array([c * local[0] - s * local[1], s * local[0] + c * local[1], local[2] + 0.9144])
+    assert end_effector_positions(ur5, np.zeros((1, 6)))[0] == pytest.approx(world, abs=1e-4)
 
 
 def row(method: str, scene: str, status: str, time: float, tf: float = 1.0) -> dict:

@@ -125,7 +125,7 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uni
      "scenarios[0].random.obstacles needs [min, max]"),
 ])
 def test_a_bad_suite_is_an_error_naming_the_field(tmp_path, monkeypatch, text, message):
-    monkeypatch.setattr("ocpkit.bench.suite.MBM_CACHE", tmp_path / "cache")  # no MBM cache, whatever this machine has
+    monkeypatch.setattr("ocpkit.bench.suite.MBM_CACHE", tmp_path / "no-cache")  # not this machine's `data mbm`
     shutil.copy(REPO / "scenarios/paper/case1.yaml", tmp_path / "a.yaml")
     (tmp_path / "suite.yaml").write_text(text)
     with pytest.raises(SuiteError) as error:
@@ -143,7 +143,7 @@ def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_p
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [3, 1]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     suite = load_suite(tmp_path / "suites/s.yaml")
-    assert [(s.scene, s.case) for s in suite.scenarios] == [("panda-cage", "problem10"), ("panda-cage", "problem1")]
+    assert [(s.scene, s.case) for s in suite.scenarios] == [("panda/cage", "problem10"), ("panda/cage", "problem1")]
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [4]}}]\n"
                                             "methods: [{planner: simultaneous}]")
     with pytest.raises(SuiteError, match=r"problems\[0\]: problem 4 does not exist"):
@@ -160,15 +160,14 @@ def test_random_source_and_repeats_give_seeded_problems_and_seeds(tmp_path):
 
 
 def test_the_shipped_suites_are_well_formed():
-    from ocpkit.bench.suite import SUITE
-    from ocpkit.schema import check, read_yaml
-
     paper = load_suite(REPO / "suites/paper.yaml")
     assert [s.case for s in paper.scenarios] == ["case1", "case2", "case3", "case4"]
     assert [m.label for m in paper.methods] == ["simultaneous", "ompl-toppra"] and paper.repeats == 3
-    mbm = read_yaml((REPO / "suites/mbm-small.yaml").read_bytes(), SuiteError)
-    check(mbm, SUITE, SuiteError)  # the MBM subset and ompl-topp3 come with their own branches
-    assert [m["planner"] for m in mbm["methods"]] == ["simultaneous", "ompl-topp3", "ompl-toppra"]
+    mbm = load_suite(REPO / "suites/mbm-small.yaml")
+    scenes = ["bookshelf_small", "bookshelf_tall", "bookshelf_thin", "box", "cage", "table_pick", "table_under_pick"]
+    assert [(s.scene, s.case) for s in mbm.scenarios] == [(f"{robot}/{scene}", f"{scene}_0001")
+                                                          for robot in ("panda", "ur5") for scene in scenes]
+    assert [m.planner for m in mbm.methods] == ["simultaneous", "ompl-topp3", "ompl-toppra"]
 
 
 def test_an_out_folder_of_another_command_or_suite_is_refused_not_overwritten(tmp_path, capsys):
@@ -228,3 +227,21 @@ def test_the_guess_and_seed_columns_follow_the_fallback_rung_that_gave_the_plan(
     assert _guess_and_seed("simultaneous", {}, None, "ompl-1") == ("ompl", 1)
     assert _guess_and_seed("simultaneous", {"guess": "ompl", "fallbacks": ()}, 4, None) == ("ompl", 4)
     assert _guess_and_seed("ompl-toppra", {"seed": 2}, 2, None) == ("", 2)
+
+
+def test_a_planner_that_raises_gives_a_failed_row_naming_the_exception_not_a_crashed_run(monkeypatch):
+    import json
+
+    import ocpkit.bench.task as task_module
+    from ocpkit.bench.task import make_task, run_task
+
+    def broken(problem, **options):
+        raise ZeroDivisionError("a planner bug")
+
+    monkeypatch.setattr(task_module, "plan", broken)
+    suite = load_suite(REPO / "suites/paper.yaml")
+    outcome = run_task(make_task("paper", suite.scenarios[0], suite.methods[1], 0))
+    row = outcome["row"]
+    assert row["status"] == "failed" and row["method"] == "ompl-toppra"
+    assert json.loads(row["extra"])["error"] == "ompl-toppra raised ZeroDivisionError: a planner bug"
+    assert json.loads(outcome["trajectory"])["status"] == "failed"
