@@ -17,7 +17,7 @@ from ocpkit.errors import ScenarioError, within
 from ocpkit.problem import Problem, TimeBounds
 from ocpkit.robots import load_robot
 from ocpkit.scene import Boxes, Cylinders, Scene, Workspace
-from ocpkit.schema import SCENARIO, check, read_yaml, show
+from ocpkit.schema import SCENARIO, check, read_bytes, read_yaml, show
 from ocpkit.validation import validate
 
 DEFAULT_GUESS = 10.0
@@ -27,10 +27,7 @@ DEFAULT_GUESS = 10.0
 def load_scenario(path: str | Path) -> Problem:
     """Read a scenario file and return its validated Problem; raises ScenarioError naming what is wrong."""
     path = Path(path)
-    try:
-        text = path.read_bytes()
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario {path}: {exc.strerror}") from exc
+    text = read_bytes(path, ScenarioError, "scenario")
     with within(path):
         return problem_from_dict(read_yaml(text, ScenarioError), base_dir=path.parent, name=path.stem)
 

@@ -18,6 +18,7 @@ import reprlib
 from abc import ABC, abstractmethod
 from collections.abc import Sequence as SequenceABC
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Literal
 
 import yaml
@@ -265,6 +266,14 @@ def check(data: Any, node: Node, error: type[OcpkitError], path: str = "") -> No
         node.check(data, path)
     except _Invalid as exc:
         raise error(str(exc)) from None
+
+
+def read_bytes(path: Path, error: type[OcpkitError], what: str) -> bytes:
+    """The content of the file at `path`; `error` naming it ("cannot read <what> <path>: reason") if unreadable."""
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise error(f"cannot read {what} {path}: {exc.strerror}") from exc
 
 
 def read_yaml(text: bytes, error: type[OcpkitError]) -> Any:

@@ -34,6 +34,7 @@ from ocpkit.schema import (
     String,
     Tagged,
     check,
+    read_bytes,
     read_yaml,
     show,
 )
@@ -124,10 +125,7 @@ class Suite:
 def load_suite(path: str | Path) -> Suite:
     """Read, check and resolve a suite file; SuiteError (or the scenario's own error) naming what is wrong."""
     path = Path(path)
-    try:
-        text = path.read_bytes()
-    except OSError as exc:
-        raise SuiteError(f"cannot read suite {path}: {exc.strerror}") from exc
+    text = read_bytes(path, SuiteError, "suite")
     with within(path):
         data = read_yaml(text, SuiteError)
         check(data, SUITE, SuiteError)
