@@ -55,7 +55,6 @@ import pinocchio as pin
 
 from ocpkit.errors import NoGuess, OptionError, RegistryError
 from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.guesses import line_guess
 from ocpkit.plan import Plan, finish
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot, rigid_torque
@@ -417,13 +416,13 @@ def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time
 def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool = True,
                **baseline_options: Any) -> np.ndarray:
     """A warm start: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`) sampled on the
-    discretization's grid by `encode`. Without a baseline trajectory: the default straight-line guess with `fallback`,
-    else NoGuess."""
+    discretization's grid by `encode`. Without a baseline trajectory: the paper's straight line (the default) with
+    `fallback`, else NoGuess."""
     baseline = plan_ompl_toppra(problem, **baseline_options)
     if baseline.status not in ("no_path", "infeasible"):
         return discretization.encode(baseline.trajectory)
     if fallback:
-        return line_guess(problem, discretization)
+        return discretization.initial_guess(problem)
     raise NoGuess(f"OMPL + TOPP-RA gave no trajectory ({baseline.status}: {baseline.stats.solver_message})")
 
 
