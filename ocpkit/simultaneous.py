@@ -16,7 +16,6 @@ from ocpkit.build_cache import build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
-from ocpkit.guesses import line_guess
 from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
@@ -96,7 +95,7 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     try:
         w = _guess(problem, made.discretization, options["guess"], options["guess_options"])
     except NoGuess as exc:
-        line = made.discretization.decode(line_guess(problem, made.discretization))
+        line = made.discretization.decode(made.discretization.initial_guess(problem))
         return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
                       message=f"guess {options['guess']!r}: {exc}; not solved")
     guess_time = time.perf_counter() - guessing

@@ -19,7 +19,6 @@ from ocpkit.plan import Plan, PlanStats
 from ocpkit.planner import GUESSES
 from ocpkit.simultaneous import (
     _overridden,
-    line_guess,
     plan_simultaneous,
 )
 from ocpkit.verify import Check, Verification
@@ -141,9 +140,9 @@ def test_a_failed_ladder_where_ompl_found_no_path_says_so():
     assert climb(script, LADDER, 60.0).hint == ""
 
 
-def test_an_ompl_guess_without_a_path_falls_back_to_the_line_only_when_asked():
+def test_an_ompl_guess_without_a_path_falls_back_to_the_papers_line_only_when_asked():
     discretization = ocpkit.build(CASE2, knots=6).discretization
-    line = line_guess(CASE2, discretization)
+    line = discretization.initial_guess(CASE2)  # the paper's rule, the planner's default
     np.testing.assert_array_equal(ompl_guess(CASE2, discretization, planning_time=0.0), line)
     with pytest.raises(NoGuess, match="no_path"):
         ompl_guess(CASE2, discretization, fallback=False, planning_time=0.0)
