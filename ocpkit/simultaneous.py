@@ -65,9 +65,12 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
     changed = dict(options)
     if rung.guess is not None:
         changed["guess"] = rung.guess
-        changed["guess_options"] = {"fallback": False, **({} if rung.seed is None else {"seed": rung.seed}),
-                                    **({"max_checks": OMPL_CHECKS, "planning_time": left} if rung.guess == "ompl"
-                                       else {})}
+        guess_options = {"fallback": False}
+        if rung.seed is not None:
+            guess_options["seed"] = rung.seed
+        if rung.guess == "ompl":
+            guess_options.update(max_checks=OMPL_CHECKS, planning_time=left)
+        changed["guess_options"] = guess_options
     if rung.knots is not None:
         changed["knots"] = rung.knots
     if rung.segments is not None:

@@ -29,7 +29,7 @@ from ocpkit.baselines.ompl_toppra import joint_path
 from ocpkit.bench.common import machine
 from ocpkit.errors import ScenarioError
 from ocpkit.geometry import sphere_centers
-from ocpkit.ladder import DEFAULT_LADDER, Rung
+from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung
 from ocpkit.plan import Plan
 from ocpkit.planner import plan
 from ocpkit.problem import Problem, TimeBounds
@@ -49,7 +49,7 @@ PATH_SPHERES = np.arange(4, 15)  # robot spheres that obstacles are placed near:
 PATH_FRACTIONS = (0.2, 0.8)  # where along the straight path
 OFFSET = 0.1  # m, standard deviation of an obstacle's offset from its robot sphere
 PATH_SEED = 1000  # OMPL seed of the room-to-pass certificate (unlike the planners' seeds 0, 1, 2, ...)
-PATH_CHECKS = 1_500_000  # configurations the certificate may check (about 20 s on one core)
+PATH_CHECKS = OMPL_CHECKS  # configurations the certificate may check: the budget of a ladder's OMPL rung
 
 
 def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
