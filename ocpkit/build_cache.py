@@ -15,10 +15,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics, make_dynamics
 from ocpkit.errors import OptionError
 from ocpkit.problem import Problem
+from ocpkit.screening import SCREEN_DISTANCE
 from ocpkit.solvers import SOLVERS, PreparedSolver
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
@@ -44,14 +47,15 @@ _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
 def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str | Dynamics = "casadi-rnea",
           solver: str = "ipopt", constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
           transcription_options: dict | None = None, solver_options: dict | None = None,
-          dynamics_options: dict | None = None, ocp: OCP | None = None) -> Build:
+          dynamics_options: dict | None = None, ocp: OCP | None = None, near: np.ndarray | None = None) -> Build:
     """The build for `problem`'s shape (module docstring): components by registered name (`ocpkit list`), a
     dynamics backend also as an instance; unknown options raise OptionError. `ocp` is the OCP to discretize:
-    the robot OCP of `problem` by default (ocpkit.transcription.ocp)."""
+    the robot OCP of `problem` by default (ocpkit.transcription.ocp). With `near` (K, n), the constraints keep only
+    the rows that can be active near those configurations (ocpkit.screening)."""
     method = construct(TRANSCRIPTIONS.get(transcription), transcription, {"knots": knots,
                                                                           **(transcription_options or {})})
     backend = make_dynamics(dynamics, problem.robot, **(dynamics_options or {}))
-    plugins = make_constraints(problem, constraints)
+    plugins = make_constraints(problem, constraints, None if near is None else (near, SCREEN_DISTANCE))
     options = solver_options or {}
     nlp_solver = construct(SOLVERS.get(solver), solver, options)  # a wrong name or option fails before a build
     key = (method.shape_key(backend, plugins, ocp), solver, frozen(options))

@@ -10,14 +10,15 @@ empty ladder plans once with the call's options (the paper's single shot).
 Why these rungs (tuned on `ocpkit bench random --seed 200 --count 40 --obstacles 1 3` and seed 300; measured
 on seed 500 in README.md): the straight line verifies most problems within a few hundred IPOPT iterations, and
 one that has not converged by then usually ends infeasible or at the iteration limit after many seconds, so the
-first rung is capped (MAX_ITERATIONS_CAPPED): that cap is how the ladder leaves a local infeasibility, a
-restoration phase or a t_f pinned at its upper bound early. The OMPL + TOPP-RA motion (collision-free by
-construction) is the better start in clutter, and another seed gives another homotopy class when the first one
-is poor; its path search is budgeted in configurations checked (OMPL_CHECKS, the budget the random suite
-certifies room to pass with), so whether it finds a path does not depend on the machine's speed. More knots
-resolve what a coarse grid leaves violated. The continuation rung solves the problem relaxed first (a softened
-margin, wider limits) and the real one from there. The last rung is the uncapped single shot with whatever time
-is left, so the ladder never loses a plan the single shot finds in time.
+first rung is capped (MAX_ITERATIONS_CAPPED, per solve and for the rung's refinement rounds together): that cap is
+how the ladder leaves a local infeasibility, a restoration phase, a t_f pinned at its upper bound, or a motion that
+keeps tunnelling through a thin obstacle between check points round after round (MBM's cage) early. The OMPL +
+TOPP-RA motion (collision-free by construction) is the better start in clutter, and another seed gives another
+homotopy class when the first one is poor; its path search is budgeted in configurations checked (OMPL_CHECKS, the
+budget the random suite certifies room to pass with), so whether it finds a path does not depend on the machine's
+speed. More knots resolve what a coarse grid leaves violated. The continuation rung solves the problem relaxed
+first (a softened margin, wider limits) and the real one from there. The last rung is the uncapped single shot with
+whatever time is left, so the ladder never loses a plan the single shot finds in time.
 """
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path (a
 @dataclass(frozen=True)
 class Rung:
     """Option overrides of one attempt: `guess` ("line", "ompl" or None for the call's), OMPL `seed`, `knots`
-    and pseudospectral `segments` (None: the call's), `max_iterations` per solve (None: the solver's), and
+    and pseudospectral `segments` (None: the call's), `max_iterations` per solve (None: the solver's; no
+    refinement round starts once the rung's solves have used that many), and
     `relaxed`: a continuation, solving the problem relaxed (ocpkit.refine.RELAXED) first to warm-start the real
     one. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's time
     is up."""

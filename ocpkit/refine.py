@@ -81,9 +81,11 @@ def margin_step(penetration: float) -> float:
 
 
 def solve_refined(discretization: Discretization, solver: PreparedSolver, problem: Problem, guess: np.ndarray,
-                  rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf, relaxed: Refinement | None = None) -> Refined:
+                  rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf, relaxed: Refinement | None = None,
+                  iteration_budget: float = np.inf) -> Refined:
     """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds, all
-    before `deadline` (time.perf_counter s). With `relaxed` (continuation), a first solve of the problem
+    before `deadline` (time.perf_counter s); no round starts once the solves have used `iteration_budget`
+    iterations. With `relaxed` (continuation), a first solve of the problem
     relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status."""
     refinement, iterations, taken, timing = Refinement(), 0, 0, []
     if relaxed is not None:
@@ -106,7 +108,8 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
                                          message=f"wall-time limit reached before refinement round {taken + 1}")
-        if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds:
+        if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds \
+                or iterations >= iteration_budget:
             return Refined(result, trajectory, verification, iterations, taken, tuple(timing))
         refinement, guess, taken = following, result.w, taken + 1
 

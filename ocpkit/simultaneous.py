@@ -6,21 +6,23 @@ across queries), an initial guess, the solve with refinement rounds (ocpkit.refi
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 from collections.abc import Sequence
 
 import numpy as np
 
-from ocpkit.build_cache import build, construct
-from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint
+from ocpkit import screening
+from ocpkit.build_cache import Build, build, construct
+from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
 from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
-from ocpkit.refine import DEFAULT_ROUNDS, RELAXED, solve_refined
+from ocpkit.refine import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization
 
@@ -32,7 +34,8 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
                       constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
                       transcription_options: dict | None = None, solver_options: dict | None = None,
                       dynamics_options: dict | None = None, max_wall_time: float = 60.0,
-                      guess_options: dict | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER) -> Plan:
+                      guess_options: dict | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER,
+                      screen: bool | None = None) -> Plan:
     """Plan `problem` with path and timing together.
 
     `knots` is N, the intervals per segment of a pseudospectral transcription (K N + 1 points on K `segments`) or
@@ -46,11 +49,13 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     (guess, every solve and refinement round, every rung): each solve gets the time left (a solver that cannot
     be interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when it
     runs out. `fallbacks` is the ladder of rungs (ocpkit.ladder), each overriding these options, tried in order
-    until one plan verifies; () plans once with these options (SINGLE_SHOT, the paper's setting)."""
+    until one plan verifies; () plans once with these options (SINGLE_SHOT, the paper's setting). `screen`: whether
+    the NLP carries only the collision rows near the motion (ocpkit.screening; None: when the robot and scene have
+    more than screening.SCREEN_ABOVE collision terms per point)."""
     options = {"transcription": transcription, "knots": knots, "dynamics": dynamics, "solver": solver,
                "guess": guess, "refinements": refinements, "constraints": constraints,
                "transcription_options": transcription_options or {}, "solver_options": solver_options or {},
-               "dynamics_options": dynamics_options, "guess_options": guess_options or {}}
+               "dynamics_options": dynamics_options, "guess_options": guess_options or {}, "screen": screen}
     return climb(lambda rung, left: _single_shot(problem, _overridden(options, rung, left), left), fallbacks,
                  max_wall_time)
 
@@ -59,7 +64,8 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
     """The options of `plan_simultaneous` with `rung`'s overrides applied (`options` itself for None); a rung's
     guess comes with its own options (its seed, and no fallback to the straight line: a rung without a start of
     its own ends `no_path` instead of repeating the line; an "ompl" rung's search budget, OMPL_CHECKS or the `left`
-    seconds of the ladder) instead of the call's; the call's own max_iterations wins over a rung's cap."""
+    seconds of the ladder) instead of the call's; the call's own max_iterations wins over a rung's cap, which caps
+    each solve and, as `iteration_budget`, the rung's refinement rounds and rebuilds."""
     if rung is None:
         return options
     changed = dict(options)
@@ -75,8 +81,9 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
         changed["knots"] = rung.knots
     if rung.segments is not None:
         changed["transcription_options"] = {**options["transcription_options"], "segments": rung.segments}
-    if rung.max_iterations is not None:
-        changed["solver_options"] = {"max_iterations": rung.max_iterations, **options["solver_options"]}
+    if rung.max_iterations is not None and "max_iterations" not in options["solver_options"]:
+        changed["solver_options"] = {**options["solver_options"], "max_iterations": rung.max_iterations}
+        changed["iteration_budget"] = rung.max_iterations
     if rung.relaxed:
         changed["relaxed"] = True
     return changed
@@ -85,11 +92,12 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
 def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     """One plan with `options` (those of `plan_simultaneous`): build, guess, solve with refinement rounds, all
     within `max_wall_time` (s) of computation. A guess rule with no start to offer (NoGuess) ends the plan as
-    `no_path` before any solve."""
+    `no_path` before any solve. With screening (ocpkit.screening) the first build keeps the collision rows near
+    the straight line; a guess or an unverified solution that comes near rows left out is solved again on a
+    rebuild with them added."""
     started = time.perf_counter()
-    made = build(problem, options["transcription"], options["knots"], options["dynamics"], options["solver"],
-                 options["constraints"], options["transcription_options"], options["solver_options"],
-                 options["dynamics_options"])
+    near = _screening_start(problem, options)
+    made = _build(problem, options, near)
     deadline = time.perf_counter() + max_wall_time
     dynamics = options["dynamics"]
     method = {"planner": "simultaneous", "transcription": options["transcription"], "knots": options["knots"],
@@ -102,14 +110,56 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
         return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
                       message=f"guess {options['guess']!r}: {exc}; not solved")
     guess_time = time.perf_counter() - guessing
+    first_setup = made.setup_time
+    if near is not None and screening.missing(problem, made.discretization.constraints,
+                                              guessed := screening.motion_samples(made.discretization.decode(w))):
+        near = np.vstack([near, guessed])
+        made = _build(problem, options, near)
+    budget = options.get("iteration_budget", np.inf)
     refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline,
-                            RELAXED if options.get("relaxed") else None)
+                            RELAXED if options.get("relaxed") else None, budget)
+    rebuilds = 0
+    while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
+            and time.perf_counter() < deadline and refined.iterations < budget \
+            and screening.missing(problem, made.discretization.constraints, motion := screening.motion_samples(
+                refined.trajectory)):
+        near, rebuilds = np.vstack([near, motion]), rebuilds + 1
+        made = _build(problem, options, near)
+        refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, refined.result.w,
+                                                    options["refinements"], deadline,
+                                                    iteration_budget=budget - refined.iterations))
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
-    return finish(problem, refined.trajectory, stopped, method, started, setup_time=made.setup_time,
+    extra = {"timing": {"guess": guess_time, "rounds": list(refined.timing), "setup": made.setup_parts}}
+    if near is not None:
+        extra["screening"] = {"rows_per_point": sum(getattr(c, "term_count", 0)
+                                                    for c in made.discretization.constraints),
+                              "rebuilds": rebuilds}
+    return finish(problem, refined.trajectory, stopped, method, started, setup_time=first_setup,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
-                  verification=refined.verification,
-                  extra={"timing": {"guess": guess_time, "rounds": list(refined.timing), "setup": made.setup_parts}})
+                  verification=refined.verification, extra=extra)
+
+
+def _screening_start(problem: Problem, options: dict) -> np.ndarray | None:
+    """The configurations the first build screens the collision rows by (the straight line), or None when the
+    plan does not screen (`screen` False, or None and too few rows to pay: ocpkit.screening)."""
+    screen = options["screen"]
+    if screen is None:
+        screen = screening.worth_screening(make_constraints(problem, options["constraints"]))
+    return screening.line_samples(problem) if screen else None
+
+
+def _build(problem: Problem, options: dict, near: np.ndarray | None) -> Build:
+    """The build of `options` (those of `plan_simultaneous`), its collision rows screened by `near`."""
+    return build(problem, options["transcription"], options["knots"], options["dynamics"], options["solver"],
+                 options["constraints"], options["transcription_options"], options["solver_options"],
+                 options["dynamics_options"], near=near)
+
+
+def _continued(before: Refined, after: Refined) -> Refined:
+    """`after`, a solve that continued from `before`'s solution, with both solves' iterations, rounds and timing."""
+    return dataclasses.replace(after, iterations=before.iterations + after.iterations,
+                               rounds=before.rounds + after.rounds, timing=before.timing + after.timing)
 
 
 def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray, options: dict) -> np.ndarray:

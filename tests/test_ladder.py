@@ -100,13 +100,13 @@ def test_a_rung_overrides_only_what_it_names():
     assert changed == {"guess": "ompl", "guess_options": {"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
                                                           "planning_time": 9.0}, "knots": 16,
                        "transcription_options": {"staged": False, "segments": 2},
-                       "solver_options": {"tol": 1e-7, "max_iterations": 300}}
+                       "solver_options": {"tol": 1e-7, "max_iterations": 300}, "iteration_budget": 300}
     assert options["knots"] == 12 and options["solver_options"] == {"tol": 1e-7}
     assert _overridden(options, Rung("same"), 9.0) == options and _overridden(options, None, 9.0) is options
     line = _overridden(options, Rung("line", guess="line"), 9.0)
     assert line["guess_options"] == {"fallback": False}
     capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300), 9.0)
-    assert capped["solver_options"] == {"max_iterations": 50}
+    assert capped["solver_options"] == {"max_iterations": 50} and "iteration_budget" not in capped
 
 
 def test_the_default_ladder_starts_with_the_calls_guess_and_ends_uncapped():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -10,6 +12,7 @@ from helpers import REPO
 from ocpkit.build_cache import build
 from ocpkit.nlp import Refinement
 from ocpkit.refine import (
+    DEFAULT_ROUNDS,
     LIMIT_BACKOFF,
     MIN_MARGIN_STEP,
     MIN_SHRINK,
@@ -19,6 +22,7 @@ from ocpkit.refine import (
     next_refinement,
     solve_refined,
 )
+from ocpkit.solvers import SolverResult, SolverStatus
 from ocpkit.verify import Check, Verification
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -111,3 +115,25 @@ def test_a_continuation_solves_the_relaxed_problem_first_and_starts_the_real_one
     assert p.read(relaxed, "margin") == pytest.approx(p.read(real, "margin") + RELAXED.extra_margin)
     assert not np.array_equal(second_guess, w)  # warm-started from the relaxed solution
     assert refined.verification.ok and refined.iterations > 0
+
+
+class Converges:
+    """A solver that 'converges' in `iterations` iterations to the guess it is given, clipped into the bounds."""
+
+    def __init__(self, iterations: int) -> None:
+        self.iterations, self.calls = iterations, 0
+
+    def solve(self, guess, parameters, bounds, max_wall_time=None):
+        self.calls += 1
+        return SolverResult(np.clip(guess, *bounds), SolverStatus.CONVERGED, self.iterations, 0.0, "converged")
+
+
+@pytest.mark.parametrize("budget, solves", [(np.inf, 1 + DEFAULT_ROUNDS), (250, 3), (100, 1)])
+def test_no_refinement_round_starts_once_the_iteration_budget_is_spent(budget, solves, monkeypatch):
+    always_one_more = lambda *_: Refinement()  # noqa: E731
+    monkeypatch.setattr(sys.modules["ocpkit.refine"], "next_refinement", always_one_more)
+    discretization = build(CASE2, knots=6).discretization
+    solver = Converges(100)  # the straight line "converged": it collides, so it never verifies
+    refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2),
+                            iteration_budget=budget)
+    assert solver.calls == solves and refined.iterations == 100 * solves and not refined.verification.ok

@@ -117,9 +117,11 @@ def check_ompl_planner(planner_name: str) -> None:
 
 
 def planning_space(problem: Problem, margin: float) -> FreeSpace:
-    """The FreeSpace OMPL plans in: `margin` (m), lowered to the start's or goal's clearance if that is smaller."""
+    """The FreeSpace OMPL plans in: `margin` (m), lowered to half the start's or goal's clearance if that is
+    smaller, as the transcriptions lower theirs (a margin as wide as an end's clearance would leave no room to
+    leave it)."""
     ends = FreeSpace(problem, 0.0).clearance(np.stack([problem.start, problem.goal]))
-    return FreeSpace(problem, min(margin, float(ends.min())))
+    return FreeSpace(problem, min(margin, 0.5 * float(ends.min())))
 
 
 # -- OMPL ---------------------------------------------------------------------------------------------

@@ -94,6 +94,15 @@ class Constraint(ABC):
         refinement's `limit_scale` applied."""
         return {}
 
+    def screened(self, problem: Problem, near: np.ndarray, distance: float) -> Constraint:
+        """This constraint for `problem` without the rows that stay inactive by more than `distance` (its own unit)
+        at every configuration of `near` (K, n) (ocpkit.screening); itself when it has nothing to leave out."""
+        return self
+
+    def missing(self, problem: Problem, near: np.ndarray, distance: float) -> int:
+        """How many rows `screened` left out are within `distance` of active in `problem` somewhere in `near`."""
+        return 0
+
     @abstractmethod
     def evaluate(self, point: PointValues, context: Context) -> Rows:
         """The rows at one point."""
@@ -104,10 +113,13 @@ DEFAULT_CONSTRAINTS = ("state-limits", "torque", "torque-rate", "collision")
 """The paper's path constraints, eqs. (6)–(8): what every planner imposes unless told otherwise."""
 
 
-def make_constraints(problem: Problem, kinds: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS
-                     ) -> list[Constraint]:
-    """The constraints `kinds` (registered names or Constraint classes) made for `problem`."""
+def make_constraints(problem: Problem, kinds: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
+                     screen: tuple[np.ndarray, float] | None = None) -> list[Constraint]:
+    """The constraints `kinds` (registered names or Constraint classes) made for `problem`; with `screen` =
+    (near (K, n), distance), each `screened` to the rows that can be active near those configurations."""
     made = [(CONSTRAINTS.get(kind) if isinstance(kind, str) else kind)(problem) for kind in kinds]
+    if screen is not None:
+        made = [c.screened(problem, *screen) for c in made]
     names = [c.name for c in made]
     repeated = sorted({name for name in names if names.count(name) > 1})
     if repeated:

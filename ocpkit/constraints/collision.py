@@ -16,14 +16,19 @@ reach ball cannot touch an obstacle or a workspace face gets no constraint for i
 constraint's shape: moving an obstacle keeps the build unless it crosses a sphere's reach boundary. Spheres
 on the fixed base never move at all; they are checked once, when the problem is validated. The clearance
 margin is an NLP parameter (a refinement round may raise it), so terms are kept up to MAX_MARGIN.
+`screened` goes further for robots with many terms: it keeps only the terms near given configurations (the
+planner's active set, ocpkit.screening); the pairs and terms kept are then part of the shape too.
 """
 
 from __future__ import annotations
+
+import copy
 
 import casadi as ca
 import numpy as np
 
 from ocpkit.constraints.base import Constraint, Context, PointValues, Rows
+from ocpkit.geometry import clearances, sphere_centers_batch
 from ocpkit.problem import Problem
 from ocpkit.robots import sphere_reach
 
@@ -61,11 +66,45 @@ class SphereCollision(Constraint):
         scene = problem.scene
         self.counts = (len(scene.obstacle_radii), len(scene.boxes), len(scene.cylinders))
         pairs = self.robot.self_collision
-        self.pairs = pairs[(self.robot.sphere_joint[pairs] > 0).any(axis=1)] if len(pairs) else pairs
+        self.pair_mask = (self.robot.sphere_joint[pairs] > 0).any(axis=1) if len(pairs) else np.zeros(0, bool)
+
+    @property
+    def pairs(self) -> np.ndarray:
+        """The self-collision sphere pairs with rows (P, 2)."""
+        return self.robot.self_collision[self.pair_mask]
+
+    @property
+    def term_count(self) -> int:
+        """Collision rows per point."""
+        return int(self.pair_mask.sum() + self.obstacle_mask.sum() + self.face_mask.any(axis=0).sum())
 
     def shape(self) -> tuple:
         return (self.counts, self.obstacle_mask.shape, self.obstacle_mask.tobytes(), self.face_mask.shape,
-                self.face_mask.tobytes())
+                self.face_mask.tobytes(), self.pair_mask.tobytes())
+
+    def screened(self, problem: Problem, near: np.ndarray, distance: float) -> SphereCollision:
+        """A copy keeping the terms whose clearance (m) is below `distance` at some configuration of `near`."""
+        close = self._close(problem, near, distance)
+        kept = copy.copy(self)
+        kept.pair_mask, kept.obstacle_mask, kept.face_mask = (mask & near_ for mask, near_ in zip(
+            (self.pair_mask, self.obstacle_mask, self.face_mask), close))
+        return kept
+
+    def missing(self, problem: Problem, near: np.ndarray, distance: float) -> int:
+        """Terms this constraint has no rows for (screened out, not beyond reach) with a clearance below `distance`
+        (m) at some configuration of `near`."""
+        unscreened = SphereCollision(problem)
+        close = self._close(problem, near, distance)
+        return int(sum((full & near_ & ~mask).sum() for full, near_, mask in zip(
+            (unscreened.pair_mask, unscreened.obstacle_mask, unscreened.face_mask), close,
+            (self.pair_mask, self.obstacle_mask, self.face_mask))))
+
+    def _close(self, problem: Problem, near: np.ndarray, distance: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Masks shaped like (pair_mask, obstacle_mask, face_mask) of the terms with a clearance (m) below
+        `distance` at some configuration of `near` (K, n) in `problem`'s scene."""
+        c = clearances(self.robot, problem.scene, sphere_centers_batch(self.robot, near))
+        return tuple(values.min(axis=0, initial=np.inf) < distance
+                     for values in (c.self_pairs, c.obstacles, c.workspace))
 
     def parameter_shapes(self) -> dict[str, tuple[int, int]]:
         spheres, boxes, cylinders = self.counts
