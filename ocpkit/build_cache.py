@@ -26,7 +26,7 @@ from ocpkit.solvers import SOLVERS, PreparedSolver
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
 
-CACHE_SIZE = 32
+CACHE_SIZE = 8  # builds; one of a 7-joint MBM problem holds 350–450 MB
 
 
 @dataclass(frozen=True)

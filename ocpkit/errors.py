@@ -22,6 +22,10 @@ class RegistryError(OcpkitError):
     """A component name (transcription, dynamics, solver, planner) is not registered."""
 
 
+class WorkerDied(OcpkitError):
+    """A benchmark worker process ended without a result (killed by the system); the run stops, its rows kept."""
+
+
 class NoGuess(Exception):
     """An initial-guess rule asked not to fall back (`fallback=False`) has no start of its own to offer (OMPL found
     no path): not a user mistake, a finding the planner reports as `no_path`."""

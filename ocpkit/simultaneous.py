@@ -24,7 +24,8 @@ from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
 from ocpkit.refine import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.solvers import SolverStatus
-from ocpkit.transcription import Discretization
+from ocpkit.transcription import TRANSCRIPTIONS, Discretization
+from ocpkit.transcription.pseudospectral import Pseudospectral
 
 
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
@@ -97,6 +98,8 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     rebuild with them added."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
+    if near is not None:
+        options = _checked_near_the_ends(options)
     made = _build(problem, options, near)
     deadline = time.perf_counter() + max_wall_time
     dynamics = options["dynamics"]
@@ -147,6 +150,15 @@ def _screening_start(problem: Problem, options: dict) -> np.ndarray | None:
     if screen is None:
         screen = screening.worth_screening(make_constraints(problem, options["constraints"]))
     return screening.line_samples(problem) if screen else None
+
+
+def _checked_near_the_ends(options: dict) -> dict:
+    """`options` with `end_checks` for a pseudospectral transcription (unless given): a problem worth screening is
+    a cluttered one, whose start and goal sit close to obstacles (ocpkit.transcription.pseudospectral)."""
+    transcription = TRANSCRIPTIONS.get(options["transcription"])
+    if not issubclass(transcription, Pseudospectral) or "end_checks" in options["transcription_options"]:
+        return options
+    return {**options, "transcription_options": {**options["transcription_options"], "end_checks": True}}
 
 
 def _build(problem: Problem, options: dict, near: np.ndarray | None) -> Build:

@@ -10,11 +10,13 @@ from ocpkit.constraints.collision import SphereCollision
 from ocpkit.geometry import clearances, sphere_centers_batch
 from ocpkit.scenario import load_scenario
 from ocpkit.screening import line_samples, worth_screening
-from ocpkit.simultaneous import plan_simultaneous
+from ocpkit.simultaneous import _checked_near_the_ends, plan_simultaneous
+from ocpkit.transcription.pseudospectral import long_interval_midpoints
 from tests.helpers import REPO
 
 PANDA = load_scenario(REPO / "scenarios/mbm/panda/table_pick/0001.yaml")
 PAPER = load_scenario(REPO / "scenarios/paper/case2.yaml")
+PLAN_OPTIONS = {"transcription": "chebyshev", "transcription_options": {}}
 
 
 def test_screening_keeps_exactly_the_terms_close_to_some_configuration():
@@ -56,3 +58,19 @@ def test_a_screened_plan_is_verified_on_every_term():
     plan = plan_simultaneous(PAPER, fallbacks=(), screen=True)
     assert plan.status == "verified"  # verification checks every term, screened or not
     assert plan.stats.extra["screening"]["rows_per_point"] < SphereCollision(PAPER).term_count
+
+
+def test_every_knot_interval_is_checked_when_asked():
+    points = np.cos(np.pi * np.arange(13) / 12)  # Chebyshev–Lobatto, N = 12
+    long_only, every = long_interval_midpoints(points), long_interval_midpoints(points, every=True)
+    assert len(every) == 12 and len(long_only) == 8  # sin θ ≥ ½ keeps the middle 8 of 12
+    assert set(np.round(long_only, 12)) <= set(np.round(every, 12))
+    assert np.all((every[:-1] - points[1:-1]) * (every[1:] - points[1:-1]) < 0)  # one between each pair of knots
+
+
+def test_a_screened_plan_checks_near_the_ends_unless_told_otherwise():
+    assert _checked_near_the_ends(PLAN_OPTIONS)["transcription_options"] == {"end_checks": True}
+    told = {**PLAN_OPTIONS, "transcription_options": {"end_checks": False}}
+    assert _checked_near_the_ends(told) is told
+    mesh = {**PLAN_OPTIONS, "transcription": "trapezoidal"}
+    assert _checked_near_the_ends(mesh) is mesh  # a mesh transcription has no such option

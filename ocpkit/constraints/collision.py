@@ -76,7 +76,23 @@ class SphereCollision(Constraint):
     @property
     def term_count(self) -> int:
         """Collision rows per point."""
-        return int(self.pair_mask.sum() + self.obstacle_mask.sum() + self.face_mask.any(axis=0).sum())
+        return int(self.pair_mask.sum() + self.obstacle_mask.sum() + len(self._face_rows()[0]))
+
+    def _face_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """(sphere, axis) of each workspace row: one per axis with a reachable face."""
+        return np.nonzero(self.face_mask[:, :3] | self.face_mask[:, 3:])
+
+    def margin_caps(self, problem: Problem) -> np.ndarray:
+        """Per row, in `evaluate`'s order: half the row's clearance (m) at the start or the goal, whichever is smaller
+        (≥ 0): the largest margin it can take while its own ends keep it."""
+        ends = clearances(self.robot, problem.scene,
+                          sphere_centers_batch(self.robot, np.stack([problem.start, problem.goal])))
+        m, axis = self._face_rows()
+        faces = np.minimum(np.where(self.face_mask[m, axis], ends.workspace[:, m, axis], np.inf),
+                           np.where(self.face_mask[m, axis + 3], ends.workspace[:, m, axis + 3], np.inf))
+        rows = np.concatenate([ends.self_pairs[:, self.pair_mask], ends.obstacles[:, self.obstacle_mask], faces],
+                              axis=1)
+        return np.maximum(0.5 * rows.min(axis=0, initial=np.inf), 0.0)
 
     def shape(self) -> tuple:
         return (self.counts, self.obstacle_mask.shape, self.obstacle_mask.tobytes(), self.face_mask.shape,
@@ -112,7 +128,8 @@ class SphereCollision(Constraint):
                 "box_center": (boxes, 3), "box_half_size": (boxes, 3), "box_rotation": (boxes, 9),
                 "cylinder_center": (cylinders, 3), "cylinder_half_size": (cylinders, 2),  # [radius, length / 2]
                 "cylinder_rotation": (cylinders, 9),  # rotations row-major
-                "workspace": (self.face_mask.shape[1], 1)}  # [lower (3), upper (3)] or nothing
+                "workspace": (self.face_mask.shape[1], 1),  # [lower (3), upper (3)] or nothing
+                "margin_cap": (self.term_count, 1)}  # per row
 
     def parameter_values(self, problem: Problem) -> dict[str, np.ndarray]:
         scene = problem.scene
@@ -124,29 +141,31 @@ class SphereCollision(Constraint):
                 "cylinder_center": cylinders.centers,
                 "cylinder_half_size": np.column_stack([cylinders.radii, 0.5 * cylinders.lengths]),
                 "cylinder_rotation": cylinders.rotations.reshape(-1, 9),
-                "workspace": np.concatenate([np.zeros(0), *box])}
+                "workspace": np.concatenate([np.zeros(0), *box]), "margin_cap": self.margin_caps(problem)}
 
     def evaluate(self, point: PointValues, context: Context) -> Rows:
-        radius, margin, p = self.robot.sphere_radius, context.margin, context.parameters
+        """Rows ≥ 0 (workspace rows of two faces ≤ 1), each with the margin min(margin, its cap) (`margin_caps`)."""
+        radius, p = self.robot.sphere_radius, context.parameters
+        margins = iter(ca.fmin(context.margin, p["margin_cap"][k]) for k in range(self.term_count))
         centers = context.dynamics.sphere_centers(point.q)
         g = []
         for a, b in self.pairs:
             gap = centers[a, :] - centers[b, :]
-            g.append(ca.dot(gap, gap) - (radius[a] + radius[b] + margin) ** 2)
+            g.append(ca.dot(gap, gap) - (radius[a] + radius[b] + next(margins)) ** 2)
         spheres, boxes, _ = self.counts
         for m, s in zip(*np.nonzero(self.obstacle_mask)):
             if s < spheres:
                 gap = centers[m, :] - p["obstacle_center"][s, :]
-                g.append(ca.dot(gap, gap) - (radius[m] + p["obstacle_radius"][s] + margin) ** 2)
+                g.append(ca.dot(gap, gap) - (radius[m] + p["obstacle_radius"][s] + next(margins)) ** 2)
             else:
                 kind, k = ("box", s - spheres) if s < spheres + boxes else ("cylinder", s - spheres - boxes)
                 local = _local(centers[m, :], p[f"{kind}_center"][k, :], p[f"{kind}_rotation"][k, :])
                 outside = _outside_squared(local, p[f"{kind}_half_size"][k, :], kind == "cylinder")
-                g.append(outside - (radius[m] + margin) ** 2)
+                g.append(outside - (radius[m] + next(margins)) ** 2)
         upper = [np.inf] * len(g)
         box = p["workspace"]
-        for m, axis in zip(*np.nonzero(self.face_mask[:, :3] | self.face_mask[:, 3:])):
-            g.append(_workspace_row(box, centers[m, axis], radius[m] + margin, axis, self.face_mask[m]))
+        for m, axis in zip(*self._face_rows()):
+            g.append(_workspace_row(box, centers[m, axis], radius[m] + next(margins), axis, self.face_mask[m]))
             upper.append(1.0 if self.face_mask[m, axis] and self.face_mask[m, axis + 3] else np.inf)
         g = ca.vertcat(*g) if g else ca.SX(0, 1)
         return Rows(g, np.zeros(g.numel()), np.asarray(upper, dtype=float))

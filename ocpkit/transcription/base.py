@@ -21,7 +21,6 @@ from ocpkit.constraints import Constraint
 from ocpkit.constraints.collision import MAX_MARGIN
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import OptionError
-from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.nlp import NLP, Refinement
 from ocpkit.problem import Problem
 from ocpkit.registry import Registry
@@ -64,13 +63,11 @@ class Discretization(ABC):
 
     def parameters(self, problem: Problem, refinement: Refinement = Refinement()) -> np.ndarray:
         """p for this problem after `refinement`. The clearance margin (grown by the refinement) is capped at
-        MAX_MARGIN and at half the start's and goal's clearance, both fixed: a larger margin would make the NLP
-        infeasible."""
+        MAX_MARGIN; each collision row caps it further at half its own clearance at the start and the goal, both
+        fixed (`SphereCollision.margin_caps`): a larger margin would make the NLP infeasible."""
         p = self.nlp.parameters
         values = np.zeros(p.size)
-        ends = clearances(problem.robot, problem.scene, sphere_centers(problem.robot, np.stack([problem.start,
-                                                                                               problem.goal])))
-        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN, 0.5 * ends.smallest())
+        margin = min(self.margin + refinement.extra_margin, MAX_MARGIN)
         shared = {"mu": problem.mu, "margin": margin, "limit_scale": refinement.limit_scale}
         owned = {f"{c.name}.{name}": value for c in self.constraints for name, value in
                  c.parameter_values(problem).items()}

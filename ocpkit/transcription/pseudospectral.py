@@ -96,12 +96,12 @@ class PseudospectralDiscretization(Discretization):
     and d/ds L(σ_k) of the adaptive check slots."""
 
     def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint], grid: Grid,
-                 margin: float, adaptive_checks: int, shape_key: tuple, ocp: OCP) -> None:
+                 margin: float, adaptive_checks: int, shape_key: tuple, ocp: OCP, end_checks: bool = False) -> None:
         N, K = grid.N, grid.K
         self.grid = grid
         D, weights = grid.family.differentiation(N), grid.family.quadrature_weights(N)
         collocated, points = grid.family.collocation_mask(N), grid.family.points(N)
-        self.check_sigma = grid.in_segments(long_interval_midpoints(points))
+        self.check_sigma = grid.in_segments(long_interval_midpoints(points, end_checks))
         self.adaptive_default = grid.to_global(K // 2, middle_quarter_points(points, adaptive_checks))
         columns = K * N + 1
 
@@ -174,13 +174,15 @@ class PseudospectralDiscretization(Discretization):
         return Trajectory(interpolant(tf * (self.grid.knots[::-1] + 1.0) / 2.0), interpolant)
 
 
-def long_interval_midpoints(points: np.ndarray) -> np.ndarray:
+def long_interval_midpoints(points: np.ndarray, every: bool = False) -> np.ndarray:
     """Local s of the fixed checks: the θ-midpoints (s = cos θ) of the knot intervals where sin θ ≥ ½, i.e.
     about half as long (in time) as the longest one. Intervals near the ends are short (knots cluster there) and
-    the robot starts and stops at rest there, so checks between them cost constraints and buy nothing."""
+    the robot starts and stops at rest there, so checks between them cost constraints and buy little — unless
+    the start or goal sits close to an obstacle, where the arm still moves fast enough to dip into it between
+    knots (MBM's goals on a shelf): `every` checks the midpoints of all intervals."""
     theta = np.arccos(points)
     middle = (theta[:-1] + theta[1:]) / 2
-    return np.cos(middle[np.sin(middle) >= 0.5 - 1e-12])
+    return np.cos(middle if every else middle[np.sin(middle) >= 0.5 - 1e-12])
 
 
 def middle_quarter_points(points: np.ndarray, count: int) -> np.ndarray:
@@ -197,16 +199,19 @@ class Pseudospectral(Transcription):
     """A pseudospectral transcription of the node family `family`: `segments` = K equal segments of N = `knots`
     intervals each (KN + 1 knot columns; K = 1 is one global polynomial). `margin` (m) is added to every sphere
     clearance so the polynomial between check times stays clear; `adaptive_checks` is the number of check slots a
-    refinement round may move."""
+    refinement round may move; `end_checks` adds fixed checks in the short intervals near the ends too
+    (`long_interval_midpoints`)."""
 
     family: NodeFamily
 
     max_intervals = 64
 
-    def __init__(self, knots: int = 12, segments: int = 1, margin: float = 0.01, adaptive_checks: int = 4) -> None:
+    def __init__(self, knots: int = 12, segments: int = 1, margin: float = 0.01, adaptive_checks: int = 4,
+                 end_checks: bool = False) -> None:
         if segments < 1:
             raise OptionError(f"{self.name} needs segments ≥ 1, got {segments}")
         self.knots, self.segments, self.margin, self.adaptive_checks = knots, segments, margin, adaptive_checks
+        self.end_checks = end_checks
         self.check_knots(knots, knots * segments)
 
     def free_path_values(self, knots: int) -> int:
@@ -215,10 +220,11 @@ class Pseudospectral(Transcription):
         return 3 * (self.segments * knots + 1) - 2 * collocated - 6
 
     def options_key(self) -> tuple:
-        return self.name, self.knots, self.segments, self.margin, self.adaptive_checks
+        return self.name, self.knots, self.segments, self.margin, self.adaptive_checks, self.end_checks
 
     def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
               ocp: OCP | None = None) -> PseudospectralDiscretization:
         return PseudospectralDiscretization(problem, dynamics, constraints, Grid(self.family, self.knots,
                                             self.segments), self.margin, self.adaptive_checks,
-                                            self.shape_key(dynamics, constraints, ocp), ocp or RobotOCP(problem.robot))
+                                            self.shape_key(dynamics, constraints, ocp), ocp or RobotOCP(problem.robot),
+                                            self.end_checks)

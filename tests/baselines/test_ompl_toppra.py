@@ -12,7 +12,8 @@ from helpers import REPO, discretize
 
 import ocpkit
 import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
-from ocpkit.baselines.ompl_toppra import FreeSpace, _space_information, _state, ompl_guess, plan_ompl_toppra
+from ocpkit.baselines.ompl_toppra import (FreeSpace, _space_information, _state, ompl_guess, plan_ompl_toppra,
+                                         planning_space)
 from ocpkit.errors import OptionError, RegistryError, ScenarioError
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.verify import GEOMETRY_TOLERANCE
@@ -174,3 +175,12 @@ def test_ompl_avoids_boxes_and_cylinders():
     result = plan_ompl_toppra(problem, seed=0)
     q = result.trajectory.sample(1e-3).q
     assert clearances(problem.robot, problem.scene, sphere_centers(problem.robot, q)).obstacles.min() >= 0
+
+
+def test_ompl_plans_with_at_most_half_the_ends_clearance_as_margin():
+    cage = ocpkit.load_scenario(REPO / "scenarios/mbm/panda/cage/0001.yaml")  # its goal is 9.4 mm from a wall
+    ends = FreeSpace(cage, 0.0).clearance(np.stack([cage.start, cage.goal])).min()
+    assert 0.0 < ends < 0.02
+    assert planning_space(cage, 0.01).margin == pytest.approx(0.5 * ends)
+    case2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")  # clear ends: the margin as asked
+    assert planning_space(case2, 0.01).margin == 0.01

@@ -43,32 +43,54 @@ def evaluate(constraint: SphereCollision, problem: ocpkit.Problem, q: np.ndarray
 
 
 def expected_rows(constraint: SphereCollision, problem: ocpkit.Problem, q: np.ndarray, margin: float) -> np.ndarray:
-    """Closed forms on pinocchio centres: ‖c_a − c_b‖² − (r_a + r_b + margin)² for self pairs and obstacle
-    spheres, max(d, 0)² − (r + margin)² with d the exact (coal-tested) distance to a box or cylinder (in mask
-    order), then one workspace row per (sphere, axis) with a reachable face."""
+    """Closed forms on pinocchio centres: ‖c_a − c_b‖² − (r_a + r_b + m)² for self pairs and obstacle spheres,
+    max(d, 0)² − (r + m)² with d the exact (coal-tested) distance to a box or cylinder (in mask order), then one
+    workspace row per (sphere, axis) with a reachable face; m = min(margin, the row's cap)."""
     c, scene = sphere_centers(ROBOT, q), problem.scene
-    rows = [np.sum((c[a] - c[b]) ** 2) - (RADIUS[a] + RADIUS[b] + margin) ** 2 for a, b in constraint.pairs]
+    margins = iter(np.minimum(margin, constraint.margin_caps(problem)))
+    rows = [np.sum((c[a] - c[b]) ** 2) - (RADIUS[a] + RADIUS[b] + next(margins)) ** 2 for a, b in constraint.pairs]
     outside = np.maximum(np.hstack([box_distance(c, scene.boxes), cylinder_distance(c, scene.cylinders)]), 0.0)
     spheres = len(scene.obstacle_radii)
     for m in range(len(RADIUS)):
         for s in range(scene.n_obstacles):
             if constraint.obstacle_mask[m, s] and s < spheres:
                 rows.append(np.sum((c[m] - scene.obstacle_centers[s]) ** 2)
-                            - (RADIUS[m] + scene.obstacle_radii[s] + margin) ** 2)
+                            - (RADIUS[m] + scene.obstacle_radii[s] + next(margins)) ** 2)
             elif constraint.obstacle_mask[m, s]:
-                rows.append(outside[m, s - spheres] ** 2 - (RADIUS[m] + margin) ** 2)
+                rows.append(outside[m, s - spheres] ** 2 - (RADIUS[m] + next(margins)) ** 2)
     faces = constraint.face_mask
     for m in range(len(RADIUS)):
         for axis in range(3):
-            low = scene.workspace.lower[axis] + RADIUS[m] + margin
-            high = scene.workspace.upper[axis] - RADIUS[m] - margin
+            if not (faces[m, axis] or faces[m, axis + 3]):
+                continue
+            inset = RADIUS[m] + next(margins)
+            low, high = scene.workspace.lower[axis] + inset, scene.workspace.upper[axis] - inset
             if faces[m, axis] and faces[m, axis + 3]:
                 rows.append((c[m, axis] - low) / (high - low))
             elif faces[m, axis]:
                 rows.append(c[m, axis] - low)
-            elif faces[m, axis + 3]:
+            else:
                 rows.append(high - c[m, axis])
+    assert next(margins, None) is None  # one cap per row
     return np.array(rows)
+
+
+def test_each_rows_margin_cap_is_half_its_clearance_at_the_nearer_end():
+    constraint = SphereCollision(PRIMITIVES)
+    caps = constraint.margin_caps(PRIMITIVES)
+    ends = [sphere_centers(ROBOT, q) for q in (PRIMITIVES.start, PRIMITIVES.goal)]
+    scene = PRIMITIVES.scene
+    pairs = [min(np.linalg.norm(c[a] - c[b]) - RADIUS[a] - RADIUS[b] for c in ends) for a, b in constraint.pairs]
+    np.testing.assert_allclose(caps[:len(pairs)], np.maximum(0.5 * np.array(pairs), 0.0), atol=1e-12)
+    m, s = np.nonzero(constraint.obstacle_mask)
+    spheres = len(scene.obstacle_radii)
+    distance = [np.hstack([np.linalg.norm(c[:, None] - scene.obstacle_centers, axis=-1) - scene.obstacle_radii,
+                           box_distance(c, scene.boxes), cylinder_distance(c, scene.cylinders)])[m, s] - RADIUS[m]
+                for c in ends]
+    obstacle_caps = caps[len(pairs):len(pairs) + len(m)]
+    np.testing.assert_allclose(obstacle_caps, np.maximum(0.5 * np.minimum(*distance), 0.0), atol=1e-12)
+    assert (obstacle_caps[s >= spheres] < 0.01).any() and (obstacle_caps > 0.05).any()  # some bind, some not
+    assert len(caps) == constraint.term_count
 
 
 def test_rows_match_closed_form_clearances_at_random_configurations():
@@ -116,7 +138,7 @@ def test_box_and_cylinder_rows_have_finite_gradients_everywhere():
 
 
 def test_obstacle_row_is_zero_when_the_sphere_touches_the_obstacle_with_margin():
-    q, m, margin = PROBLEM.start, 13, 0.03
+    q, m, margin = 0.5 * (PROBLEM.start + PROBLEM.goal), 13, 0.03  # midway: the obstacle is far from both ends
     centre = sphere_centers(ROBOT, q)[m]
     direction = np.array([0.6, 0.0, 0.8])
     touching = with_scene(obstacle_centers=(centre + (RADIUS[m] + 0.1 + margin) * direction)[None],
@@ -124,6 +146,7 @@ def test_obstacle_row_is_zero_when_the_sphere_touches_the_obstacle_with_margin()
     constraint = SphereCollision(touching)
     g, _, _ = evaluate(constraint, touching, q, margin)
     row = len(constraint.pairs) + int(np.flatnonzero(constraint.obstacle_mask[:, 0]).tolist().index(m))
+    assert constraint.margin_caps(touching)[row] > margin  # so the row takes the whole margin
     assert g[row] == pytest.approx(0.0, abs=1e-12)
 
 
@@ -151,7 +174,7 @@ def test_parameters_are_the_obstacles_and_the_box_by_name():
     assert constraint.parameter_shapes() == {
         "obstacle_center": (1, 3), "obstacle_radius": (1, 1), "box_center": (0, 3), "box_half_size": (0, 3),
         "box_rotation": (0, 9), "cylinder_center": (0, 3), "cylinder_half_size": (0, 2), "cylinder_rotation": (0, 9),
-        "workspace": (6, 1)}
+        "workspace": (6, 1), "margin_cap": (constraint.term_count, 1)}
     values = constraint.parameter_values(PROBLEM)
     np.testing.assert_array_equal(values["obstacle_center"], PROBLEM.scene.obstacle_centers)
     np.testing.assert_array_equal(values["obstacle_radius"], PROBLEM.scene.obstacle_radii)
