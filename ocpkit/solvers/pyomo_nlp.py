@@ -75,6 +75,8 @@ _UNARY: dict[int, Callable] = {
 _BINARY: dict[int, Callable] = {
     ca.OP_ADD: operator.add, ca.OP_SUB: operator.sub, ca.OP_MUL: operator.mul, ca.OP_DIV: operator.truediv,
     ca.OP_POW: operator.pow, ca.OP_CONSTPOW: operator.pow,
+    ca.OP_FMIN: lambda a, b: (a + b - abs(a - b)) / 2,  # exactly min(a, b): e.g. a row's capped margin
+    ca.OP_FMAX: lambda a, b: (a + b + abs(a - b)) / 2,  # exactly max(a, b): e.g. a box's outside excess
 }
 _LEAVES = (ca.OP_INPUT, ca.OP_CONST)
 _OP_NAMES = {getattr(ca, name): name for name in dir(ca) if name.startswith("OP_")}

@@ -77,8 +77,8 @@ def test_an_nlp_around_a_callback_is_refused(dynamics):
 
 def test_an_operation_without_translation_is_named():
     nlp = rosenbrock_disk()
-    nlp = replace(nlp, f=nlp.f + ca.fmax(nlp.x[0], nlp.x[1]))
-    with pytest.raises(OptionError, match="OP_FMAX"):
+    nlp = replace(nlp, f=nlp.f + ca.atan2(nlp.x[0], nlp.x[1]))
+    with pytest.raises(OptionError, match="OP_ATAN2"):
         PyomoRipopt().prepare(nlp)
 
 
