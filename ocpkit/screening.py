@@ -28,9 +28,14 @@ MAX_REBUILDS = 3
 SAMPLES = 64  # configurations sampled along a motion (evenly in time)
 
 
+def screenable_rows(constraints: Sequence[Constraint]) -> int:
+    """The rows per point of `constraints` that screening may leave out (`Constraint.term_count`)."""
+    return sum(c.term_count for c in constraints)
+
+
 def worth_screening(constraints: Sequence[Constraint]) -> bool:
     """Whether the constraints have more than SCREEN_ABOVE screenable terms per point."""
-    return sum(getattr(c, "term_count", 0) for c in constraints) > SCREEN_ABOVE
+    return screenable_rows(constraints) > SCREEN_ABOVE
 
 
 def line_samples(problem: Problem) -> np.ndarray:

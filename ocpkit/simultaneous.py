@@ -24,6 +24,7 @@ from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
 from ocpkit.refine import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.solvers import SolverStatus
+from ocpkit.trajectory import Trajectory
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.pseudospectral import Pseudospectral
 
@@ -114,20 +115,16 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
                       message=f"guess {options['guess']!r}: {exc}; not solved")
     guess_time = time.perf_counter() - guessing
     first_setup = made.setup_time
-    if near is not None and screening.missing(problem, made.discretization.constraints,
-                                              guessed := screening.motion_samples(made.discretization.decode(w))):
-        near = np.vstack([near, guessed])
-        made = _build(problem, options, near)
+    if near is not None and (wider := _widened(problem, options, made, near, made.discretization.decode(w))):
+        made, near = wider
     budget = options.get("iteration_budget", np.inf)
     refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline,
                             RELAXED if options.get("relaxed") else None, budget)
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
             and time.perf_counter() < deadline and refined.iterations < budget \
-            and screening.missing(problem, made.discretization.constraints, motion := screening.motion_samples(
-                refined.trajectory)):
-        near, rebuilds = np.vstack([near, motion]), rebuilds + 1
-        made = _build(problem, options, near)
+            and (wider := _widened(problem, options, made, near, refined.trajectory)):
+        (made, near), rebuilds = wider, rebuilds + 1
         refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, refined.result.w,
                                                     options["refinements"], deadline,
                                                     iteration_budget=budget - refined.iterations))
@@ -135,8 +132,7 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     extra = {"timing": {"guess": guess_time, "rounds": list(refined.timing), "setup": made.setup_parts}}
     if near is not None:
-        extra["screening"] = {"rows_per_point": sum(getattr(c, "term_count", 0)
-                                                    for c in made.discretization.constraints),
+        extra["screening"] = {"rows_per_point": screening.screenable_rows(made.discretization.constraints),
                               "rebuilds": rebuilds}
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=first_setup,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
@@ -166,6 +162,17 @@ def _build(problem: Problem, options: dict, near: np.ndarray | None) -> Build:
     return build(problem, options["transcription"], options["knots"], options["dynamics"], options["solver"],
                  options["constraints"], options["transcription_options"], options["solver_options"],
                  options["dynamics_options"], near=near)
+
+
+def _widened(problem: Problem, options: dict, made: Build, near: np.ndarray,
+             motion: Trajectory) -> tuple[Build, np.ndarray] | None:
+    """The rebuild screened by `near` and samples of `motion` when `motion` comes near rows `made` left out
+    (ocpkit.screening), with those configurations (K, n); None when it does not."""
+    samples = screening.motion_samples(motion)
+    if not screening.missing(problem, made.discretization.constraints, samples):
+        return None
+    near = np.vstack([near, samples])
+    return _build(problem, options, near), near
 
 
 def _continued(before: Refined, after: Refined) -> Refined:

@@ -40,13 +40,10 @@ def run_shapes_benchmark(scenario: Path = DEFAULT_SCENARIO, knots: int = 12, rep
 def _row(label: str, problem: Problem, knots: int, repeats: int) -> dict:
     collision = SphereCollision(problem)
     spheres = len(problem.scene.obstacle_radii)
-    obstacle_rows = int(collision.obstacle_mask.sum())
     primitive_rows = int(collision.obstacle_mask[:, spheres:].sum())
-    faces = collision.face_mask
-    face_rows = int((faces[:, :3] | faces[:, 3:]).sum()) if faces.shape[1] else 0
     nlp_rows = build(problem, knots=knots).discretization.nlp.g.numel()
     measured = measure(problem, repeats, knots=knots, fallbacks=SINGLE_SHOT)
-    return {"scene": label, "collision_rows": len(collision.pairs) + obstacle_rows + face_rows,
+    return {"scene": label, "collision_rows": collision.term_count,
             "primitive_rows": primitive_rows, "nlp_rows": nlp_rows, "status": measured.plan.status,
             "tf": measured.plan.trajectory.tf, "iterations": measured.plan.stats.iterations,
             "solve_time": measured.solve_time}

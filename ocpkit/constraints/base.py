@@ -94,6 +94,11 @@ class Constraint(ABC):
         refinement's `limit_scale` applied."""
         return {}
 
+    @property
+    def term_count(self) -> int:
+        """Rows per point that `screened` may leave out; 0 for a constraint that screens nothing."""
+        return 0
+
     def screened(self, problem: Problem, near: np.ndarray, distance: float) -> Constraint:
         """This constraint for `problem` without the rows that stay inactive by more than `distance` (its own unit)
         at every configuration of `near` (K, n) (ocpkit.screening); itself when it has nothing to leave out."""
