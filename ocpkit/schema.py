@@ -78,10 +78,11 @@ class Node(ABC):
 @dataclass(frozen=True)
 class Number(Node):
     """A finite real number, or with `integer` an integer (not 1.0); booleans are neither. `sign` 'positive'
-    (> 0) or 'non-negative' (≥ 0)."""
+    (> 0) or 'non-negative' (≥ 0). With `unbounded`, +inf (YAML `.inf`) fits too: "no limit"."""
 
     sign: Sign | None = None
     integer: bool = False
+    unbounded: bool = False
 
     def describe(self) -> str:
         return "an integer" if self.integer else "a number"
@@ -91,8 +92,9 @@ class Number(Node):
         return isinstance(value, kind) and not isinstance(value, bool)
 
     def _check_inside(self, value: Any, path: str) -> None:
-        if not _finite(value):
-            raise _Invalid(f"{_label(path)} must be finite, got {show(value)}")
+        if not _finite(value) and not (self.unbounded and value == math.inf):
+            allowed = "finite or .inf (no limit)" if self.unbounded else "finite"
+            raise _Invalid(f"{_label(path)} must be {allowed}, got {show(value)}")
         _check_sign(self.sign, value, path)
 
 

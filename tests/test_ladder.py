@@ -3,6 +3,8 @@ rung overrides, OMPL rungs without a path, and the single shot of the paper."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from helpers import REPO
@@ -107,6 +109,14 @@ def test_a_rung_overrides_only_what_it_names():
     assert line["guess_options"] == {"fallback": False}
     capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300), 9.0)
     assert capped["solver_options"] == {"max_iterations": 50} and "iteration_budget" not in capped
+
+
+def test_without_a_wall_time_limit_the_ladder_ends_by_its_budgets_in_work_and_repeats():
+    ompl = _overridden({"guess": "line", "guess_options": {}}, Rung("o", guess="ompl", seed=0), math.inf)
+    assert ompl["guess_options"]["planning_time"] == math.inf and ompl["guess_options"]["max_checks"] == OMPL_CHECKS
+    plans = [plan_simultaneous(CASE2, knots=6, max_wall_time=math.inf) for _ in range(2)]
+    assert all(p.ok for p in plans) and plans[0].stats.iterations == plans[1].stats.iterations
+    np.testing.assert_array_equal(plans[0].trajectory.knots.q, plans[1].trajectory.knots.q)
 
 
 def test_the_default_ladder_starts_with_the_calls_guess_and_ends_uncapped():

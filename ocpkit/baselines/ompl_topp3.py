@@ -26,7 +26,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ocpkit.baselines.ompl_toppra import (_hold, _import_backends, _ompl_path, _smooth_path, _time_optimal,
+from ocpkit.baselines.ompl_toppra import (_hold, _import_backends, _no_path, _ompl_path, _smooth_path, _time_optimal,
                                          check_ompl_planner, planning_space)
 from ocpkit.build_cache import build
 from ocpkit.dynamics import Dynamics
@@ -143,7 +143,7 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "margin_m": free.margin}
     if found.waypoints is None:
         return finish(problem, _hold(problem), "no_path", method, began, setup_time=setup, extra=extra, found=False,
-                      message=f"{planner_name}: no exact path within {planning_time:g} s; the plan holds the start")
+                      message=f"{_no_path(planner_name, planning_time, free)}; the plan holds the start")
     smooth, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
     timing = time_path(problem, smooth, transcription, knots, dynamics, solver, refinements, transcription_options,
                        solver_options, dynamics_options, max_wall_time, grid_points)

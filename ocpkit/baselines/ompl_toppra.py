@@ -234,6 +234,13 @@ def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_ti
         return _OmplResult(waypoints, path_time, time.perf_counter() - start - path_time)
 
 
+def _no_path(planner_name: str, planning_time: float, free: FreeSpace) -> str:
+    """What a search that found no exact path spent: its seconds (unless unlimited) and its validity checks."""
+    spent = f"{free.checks} validity checks" if np.isinf(planning_time) else \
+        f"{planning_time:g} s and {free.checks} validity checks"
+    return f"{planner_name}: no exact path within {spent}"
+
+
 # -- smooth path --------------------------------------------------------------------------------------
 
 
@@ -388,8 +395,8 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
                       found=found)
 
     if found.waypoints is None:
-        return done(_hold(problem), "no_path", f"{planner_name}: no exact path within {planning_time:g} s "
-                    f"and {free.checks} validity checks; no trajectory: the plan holds the start", found=False)
+        return done(_hold(problem), "no_path", f"{_no_path(planner_name, planning_time, free)}; no trajectory: the "
+                    "plan holds the start", found=False)
     smoothing = time.perf_counter()
     path, rounds = _smooth_path(found.waypoints, free, resolution)
     timing = time.perf_counter()

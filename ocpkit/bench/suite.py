@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import glob
 import inspect
+import math
 import os
 import re
 from dataclasses import dataclass, field
@@ -51,15 +52,18 @@ MBM_SHIPPED = Path("scenarios") / "mbm"
 RANDOM_ROBOTS = ("industrial6",)
 
 _INTEGER = Number("positive", integer=True)
+_SECONDS = Number("positive", unbounded=True)
 METHOD = Mapping(
     required={"planner": String("a planner name")},
     optional={"transcription": String(), "knots": _INTEGER, "segments": _INTEGER, "solver": String(),
               "dynamics": String(), "guess": String(), "refinements": Number("non-negative", integer=True),
-              "max_wall_time": Number("positive"), "single_shot": Choice((True, False)),
+              "max_wall_time": _SECONDS, "single_shot": Choice((True, False)),
               "seed": Number("non-negative", integer=True), "planner_name": String(),
-              "planning_time": Number("positive"), "max_checks": _INTEGER, "label": String()},
+              "planning_time": _SECONDS, "max_checks": _INTEGER, "label": String()},
 )
-"""One method of the grid: a planner and its options (`label` names it in tables; default: planner + options)."""
+"""One method of the grid: a planner and its options (`label` names it in tables; default: planner + options).
+`max_wall_time` and `planning_time` may be `.inf`: no wall-clock limit, so that the plan ends by budgets counted in
+work (IPOPT iterations, configurations checked: `max_checks`) and the row repeats on any machine and load."""
 SOURCE = Tagged({
     "paths": Sequence(String("a file or glob"), min_length=1),
     "mbm": Mapping(required={"robot": String(), "scenes": Sequence(String(), min_length=1)},
@@ -239,6 +243,9 @@ def _method(data: dict, where: str) -> Method:
         if options["planner_name"] not in OMPL_PLANNERS:
             raise SuiteError(f"{where}.planner_name: unknown OMPL planner {options['planner_name']!r}; known: "
                              f"{', '.join(OMPL_PLANNERS)}")
+    if options.get("planning_time") == math.inf and "max_checks" not in options:
+        raise SuiteError(f"{where}.planning_time: .inf needs max_checks (OMPL's budget in configurations checked), "
+                         "or the path search may never end")
     if planner == "simultaneous":
         _check_transcription(options, where)
         if "seed" in options and options.get("guess") != "ompl":

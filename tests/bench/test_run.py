@@ -4,6 +4,7 @@ and resumed; suite files checked with errors naming the field."""
 from __future__ import annotations
 
 import csv
+import math
 import os
 import shutil
 import signal
@@ -125,6 +126,14 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uni
      "run `ocpkit data mbm`"),
     ("scenarios: [{random: {count: 2, obstacles: [3, 1]}}]\nmethods: [{planner: simultaneous}]",
      "scenarios[0].random.obstacles needs [min, max]"),
+    ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, max_wall_time: .nan}]",
+     "methods[0].max_wall_time must be finite or .inf (no limit)"),
+    ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, max_wall_time: -.inf}]",
+     "methods[0].max_wall_time must be finite or .inf"),
+    ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, knots: .inf}]",
+     "methods[0].knots must be an integer"),
+    ("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: ompl-toppra, planning_time: .inf}]",
+     "methods[0].planning_time: .inf needs max_checks"),
 ])
 def test_a_bad_suite_is_an_error_naming_the_field(tmp_path, monkeypatch, text, message):
     monkeypatch.setattr("ocpkit.bench.suite.MBM_CACHE", tmp_path / "no-cache")  # not this machine's `data mbm`
@@ -133,6 +142,16 @@ def test_a_bad_suite_is_an_error_naming_the_field(tmp_path, monkeypatch, text, m
     with pytest.raises(SuiteError) as error:
         load_suite(tmp_path / "suite.yaml")
     assert message in str(error.value)
+
+
+def test_wall_time_limits_may_be_lifted_so_that_budgets_in_work_end_the_plan(tmp_path):
+    shutil.copy(REPO / "scenarios/paper/case1.yaml", tmp_path / "a.yaml")
+    (tmp_path / "s.yaml").write_text("scenarios: [{paths: [a.yaml]}]\nmethods: [{planner: simultaneous, "
+                                     "max_wall_time: .inf}, {planner: ompl-toppra, planning_time: .inf, "
+                                     "max_checks: 1000}]")
+    simultaneous, ompl = load_suite(tmp_path / "s.yaml").methods
+    assert simultaneous.options == {"max_wall_time": math.inf}
+    assert ompl.options == {"planning_time": math.inf, "max_checks": 1000}
 
 
 def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_path, monkeypatch):
