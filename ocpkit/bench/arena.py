@@ -24,8 +24,10 @@ STATUSES = ("verified", "violated", "infeasible", "iteration_limit", "time_limit
 
 
 def write_arena_logs(rows: list[dict], folder: Path, suite: str) -> list[Path]:
-    """One OMPL benchmark log per scene of `rows` in `folder`; returns their paths."""
+    """One OMPL benchmark log per scene of `rows` in `folder`, scenes, methods and runs sorted (not in the order the
+    plans finished); returns their paths."""
     folder.mkdir(parents=True, exist_ok=True)
+    rows = sorted(rows, key=lambda r: (r["scene"], r["method"], r["case"], int(r["repeat"])))
     paths = []
     for scene in dict.fromkeys(r["scene"] for r in rows):
         path = folder / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', scene)}.log"

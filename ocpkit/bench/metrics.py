@@ -61,12 +61,13 @@ SUMMARY_COLUMNS = ("runs", "success_%", "time_mean_s", "time_median_s", "time_p7
 
 
 def summarize(rows: list[dict], by: tuple[str, ...]) -> list[dict]:
-    """One summary row per distinct value of the `by` columns of results `rows` (in order of first appearance):
-    the group's names, then SUMMARY_COLUMNS (NaN where no run verified)."""
+    """One summary row per distinct value of the `by` columns of results `rows`, sorted by those values (the rows'
+    order, the order plans finished in, changes nothing): the group's names, then SUMMARY_COLUMNS (NaN where no run
+    verified)."""
     groups: dict[tuple, list[dict]] = {}
     for row in rows:
         groups.setdefault(tuple(row[c] for c in by), []).append(row)
-    return [{**dict(zip(by, names)), **_figures(group)} for names, group in groups.items()]
+    return [{**dict(zip(by, names)), **_figures(groups[names])} for names in sorted(groups, key=_text)]
 
 
 def _figures(rows: list[dict]) -> dict:
@@ -96,7 +97,13 @@ def success_grid(rows: list[dict], across: str = "scene", down: str = "method") 
 
 
 def _distinct(rows: list[dict], column: str) -> list:
-    return list(dict.fromkeys(r[column] for r in rows))
+    """The values of `column` in `rows`, each once, sorted."""
+    return sorted(dict.fromkeys(r[column] for r in rows), key=_text)
+
+
+def _text(value: object) -> tuple | str:
+    """A sort key for table values of any type: their text."""
+    return tuple(map(str, value)) if isinstance(value, tuple) else str(value)
 
 
 def formatted(value: object, digits: int = 3) -> str:

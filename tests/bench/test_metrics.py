@@ -78,3 +78,14 @@ def test_summary_times_are_over_the_verified_runs_and_success_is_a_rate():
     methods, scenes, rates = success_grid(rows)
     assert methods == ["a", "b"] and scenes == ["s1", "s2"]
     assert rates[0].tolist() == [100.0, 0.0] and rates[1, 0] == 0.0 and np.isnan(rates[1, 1])
+
+
+def test_the_tables_do_not_depend_on_the_order_the_plans_finished_in():
+    rows = [row("b", "s2", "verified", 1.0), row("a", "s1", "violated", 2.0), row("b", "s1", "verified", 3.0),
+            row("a", "s2", "verified", 4.0)]
+    for by in (("method",), ("method", "scene")):
+        assert str(summarize(rows, by)) == str(summarize(rows[::-1], by))  # NaN cells too
+        assert [tuple(r[c] for c in by) for r in summarize(rows, by)] == sorted({tuple(r[c] for c in by) for r in rows})
+    forward, backward = success_grid(rows), success_grid(rows[::-1])
+    assert forward[:2] == backward[:2] == (["a", "b"], ["s1", "s2"])
+    np.testing.assert_array_equal(forward[2], backward[2])
