@@ -67,7 +67,8 @@ def summarize(rows: list[dict], by: tuple[str, ...]) -> list[dict]:
     groups: dict[tuple, list[dict]] = {}
     for row in rows:
         groups.setdefault(tuple(row[c] for c in by), []).append(row)
-    return [{**dict(zip(by, names)), **_figures(groups[names])} for names in sorted(groups, key=_text)]
+    ordered = sorted(groups, key=lambda names: tuple(map(str, names)))
+    return [{**dict(zip(by, names)), **_figures(groups[names])} for names in ordered]
 
 
 def _figures(rows: list[dict]) -> dict:
@@ -97,13 +98,8 @@ def success_grid(rows: list[dict], across: str = "scene", down: str = "method") 
 
 
 def _distinct(rows: list[dict], column: str) -> list:
-    """The values of `column` in `rows`, each once, sorted."""
-    return sorted(dict.fromkeys(r[column] for r in rows), key=_text)
-
-
-def _text(value: object) -> tuple | str:
-    """A sort key for table values of any type: their text."""
-    return tuple(map(str, value)) if isinstance(value, tuple) else str(value)
+    """The values of `column` in `rows`, each once, sorted by their text."""
+    return sorted({r[column] for r in rows}, key=str)
 
 
 def formatted(value: object, digits: int = 3) -> str:
