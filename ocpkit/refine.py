@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,10 +83,12 @@ def margin_step(penetration: float) -> float:
 
 def solve_refined(discretization: Discretization, solver: PreparedSolver, problem: Problem, guess: np.ndarray,
                   rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf, relaxed: Refinement | None = None,
-                  iteration_budget: float = np.inf) -> Refined:
+                  iteration_budget: float = np.inf,
+                  lacking: Callable[[Trajectory], bool] | None = None) -> Refined:
     """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds, all
     before `deadline` (time.perf_counter s); no round starts once the solves have used `iteration_budget`
-    iterations. With `relaxed` (continuation), a first solve of the problem
+    iterations, nor once `lacking` says an unverified trajectory needs rows this NLP does not have (screening:
+    the caller rebuilds instead). With `relaxed` (continuation), a first solve of the problem
     relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status."""
     refinement, iterations, taken, timing = Refinement(), 0, 0, []
     if relaxed is not None:
@@ -109,7 +112,7 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
                                          message=f"wall-time limit reached before refinement round {taken + 1}")
         if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds \
-                or iterations >= iteration_budget:
+                or iterations >= iteration_budget or (lacking is not None and lacking(trajectory)):
             return Refined(result, trajectory, verification, iterations, taken, tuple(timing))
         refinement, guess, taken = following, result.w, taken + 1
 

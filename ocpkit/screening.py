@@ -7,7 +7,9 @@ than SCREEN_ABOVE terms per point, the planner builds the NLP with the terms who
 SCREEN_DISTANCE somewhere along the straight line and along the initial guess (`Constraint.screened`), solves,
 and — verification always checks every term densely — keeps a verified plan as it is. An unverified plan whose
 motion comes within MISSING_DISTANCE of a term left out is solved again, warm-started, with the terms near it
-added (a rebuild, part of the computation time), at most MAX_REBUILDS times. Below SCREEN_ABOVE (the paper's
+added (a rebuild, part of the computation time), at most MAX_REBUILDS times; such a motion also ends the
+refinement rounds at once (ocpkit.refine), since rounds on an NLP without those rows cannot fix it (before, a
+capped rung spent its iterations on them and ended `violated`, the rows still missing). Below SCREEN_ABOVE (the paper's
 robot: 75 terms) the NLP keeps every term within reach, as before.
 """
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -119,7 +119,7 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
         made, near = wider
     budget = options.get("iteration_budget", np.inf)
     refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline,
-                            RELAXED if options.get("relaxed") else None, budget)
+                            RELAXED if options.get("relaxed") else None, budget, _lacking(problem, made, near))
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
             and time.perf_counter() < deadline and refined.iterations < budget \
@@ -127,7 +127,8 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
         (made, near), rebuilds = wider, rebuilds + 1
         refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, refined.result.w,
                                                     options["refinements"], deadline,
-                                                    iteration_budget=budget - refined.iterations))
+                                                    iteration_budget=budget - refined.iterations,
+                                                    lacking=_lacking(problem, made, near)))
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     extra = {"timing": {"guess": guess_time, "rounds": list(refined.timing), "setup": made.setup_parts}}
@@ -162,6 +163,15 @@ def _build(problem: Problem, options: dict, near: np.ndarray | None) -> Build:
     return build(problem, options["transcription"], options["knots"], options["dynamics"], options["solver"],
                  options["constraints"], options["transcription_options"], options["solver_options"],
                  options["dynamics_options"], near=near)
+
+
+def _lacking(problem: Problem, made: Build, near: np.ndarray | None) -> Callable[[Trajectory], bool] | None:
+    """With screening (`near` given): whether a motion comes near rows `made` left out (ocpkit.screening), which
+    ends its refinement rounds so the plan rebuilds with them instead; None without screening."""
+    if near is None:
+        return None
+    return lambda motion: screening.missing(problem, made.discretization.constraints,
+                                            screening.motion_samples(motion)) > 0
 
 
 def _widened(problem: Problem, options: dict, made: Build, near: np.ndarray,

@@ -137,3 +137,15 @@ def test_no_refinement_round_starts_once_the_iteration_budget_is_spent(budget, s
     refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2),
                             iteration_budget=budget)
     assert solver.calls == solves and refined.iterations == 100 * solves and not refined.verification.ok
+
+
+def test_no_refinement_round_starts_once_the_motion_needs_rows_the_nlp_lacks(monkeypatch):
+    """Screening: rounds on an NLP without the rows the motion now needs are wasted; the caller rebuilds."""
+    always_one_more = lambda *_: Refinement()  # noqa: E731
+    monkeypatch.setattr(sys.modules["ocpkit.refine"], "next_refinement", always_one_more)
+    discretization = build(CASE2, knots=6).discretization
+    asked = []
+    lacking = lambda motion: asked.append(motion.tf) or len(asked) == 2  # noqa: E731  (after the second solve)
+    solver = Converges(10)
+    refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), lacking=lacking)
+    assert solver.calls == 2 and refined.rounds == 1 and not refined.verification.ok
