@@ -9,8 +9,9 @@ Scenario sources:
 - `paths`: scenario files or globs, relative to the suite file; scene = the file's folder name.
 - `mbm`: `{robot, scenes, problems}`: the MotionBenchMaker problems converted to scenario files, looked up in
   `scenarios/mbm/<robot>/<scene>/` next to the suite file or in its parent folder (the shipped subset), then in
-  the cache folder of `ocpkit data mbm` (MBM_CACHE). Problem k (1-based) is the k-th file of the scene folder in
-  natural order (problem2 before problem10); all of them when `problems` is left out. Their scene is ROBOT/SCENE
+  the cache folder of `ocpkit data mbm` (MBM_CACHE): the first of these that holds every problem asked for.
+  Problem k (1-based) is the k-th file of the scene folder in natural order (problem2 before problem10); all of
+  the first folder's when `problems` is left out. Their scene is ROBOT/SCENE
   (e.g. panda/cage: both robots have the same scenes and problem names).
 - `random`: `{robot: industrial6, count, seed, obstacles: [min, max]}`: ocpkit.bench.random.random_problems.
 """
@@ -192,16 +193,17 @@ def _mbm(body: dict, base: Path, where: str) -> list[Scenario]:
     scenarios = []
     for scene in body["scenes"]:
         folders = mbm_folders(body["robot"], scene, base)
-        folder = next((f for f in folders if any(f.glob("*.yaml"))), None)
-        if folder is None:
+        found = [files for f in folders if (files := sorted(f.glob("*.yaml"), key=_natural))]
+        if not found:
             raise SuiteError(f"{where}: no MBM scenario files for robot {show(body['robot'])}, scene {show(scene)} "
                              f"in {', '.join(map(str, folders))}; run `ocpkit data mbm` to convert them")
-        files = sorted(folder.glob("*.yaml"), key=_natural)
-        numbers = body.get("problems", range(1, len(files) + 1))
-        for k, number in enumerate(numbers):
-            if number > len(files):
-                raise SuiteError(f"{where}.problems[{k}]: problem {number} does not exist: {folder} has "
-                                 f"{len(files)} problems")
+        numbers = body.get("problems", range(1, len(found[0]) + 1))
+        files = next((files for files in found if len(files) >= max(numbers)), None)
+        if files is None:
+            k = list(numbers).index(max(numbers))
+            raise SuiteError(f"{where}.problems[{k}]: problem {numbers[k]} does not exist: the most problems found "
+                             f"for {body['robot']}/{scene} are {max(map(len, found))} (in "
+                             f"{', '.join(map(str, folders))}); `ocpkit data mbm` converts all of them")
         scenarios += [_from_file(files[number - 1], f"{body['robot']}/{scene}") for number in numbers]
     return scenarios
 

@@ -17,6 +17,7 @@ import pytest
 from helpers import REPO
 
 from ocpkit.bench.run import _in_processes, run_suite
+from ocpkit.bench import suite as suite_module
 from ocpkit.bench.suite import SuiteError, load_suite
 from ocpkit.cli import main
 from ocpkit.errors import WorkerDied
@@ -165,10 +166,17 @@ def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_p
                                             "methods: [{planner: simultaneous}]")
     suite = load_suite(tmp_path / "suites/s.yaml")
     assert [(s.scene, s.case) for s in suite.scenarios] == [("panda/cage", "problem10"), ("panda/cage", "problem1")]
+    monkeypatch.setattr(suite_module, "MBM_CACHE", tmp_path / "cache")  # empty
     (tmp_path / "suites/s.yaml").write_text("scenarios: [{mbm: {robot: panda, scenes: [cage], problems: [4]}}]\n"
                                             "methods: [{planner: simultaneous}]")
-    with pytest.raises(SuiteError, match=r"problems\[0\]: problem 4 does not exist"):
+    with pytest.raises(SuiteError, match=r"problems\[0\]: problem 4 does not exist: the most problems found for "
+                                         r"panda/cage are 3"):
         load_suite(tmp_path / "suites/s.yaml")
+    cached = tmp_path / "cache/panda/cage"
+    cached.mkdir(parents=True)
+    for k in range(1, 5):
+        (cached / f"{k:04d}.yaml").write_text(text)
+    assert [s.case for s in load_suite(tmp_path / "suites/s.yaml").scenarios] == ["0004"]  # from `ocpkit data mbm`
 
 
 def test_random_source_and_repeats_give_seeded_problems_and_seeds(tmp_path):
