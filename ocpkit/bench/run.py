@@ -45,6 +45,8 @@ def run_suite(suite_file: str | Path, out: str | Path, jobs: int = 1, scheduler:
     where = f"Dask scheduler {scheduler}" if scheduler else f"{jobs} process{'es' if jobs > 1 else ''}"
     print(f"suite {suite.name}: {len(suite.scenarios)} scenarios x {len(suite.methods)} methods x "
           f"{repeats or suite.repeats} repeats = {len(tasks)} rows, {len(pending)} to run on {where}", flush=True)
+    if suite.left_out:
+        print(f"left out, invalid for the robot model: {'; '.join(suite.left_out)}", flush=True)
     with reported_on_interrupt(results), tqdm(total=len(tasks), initial=len(tasks) - len(pending), unit="plan",
                                               disable=not progress, dynamic_ncols=True) as bar:
         for outcome in _outcomes(pending, jobs, scheduler):

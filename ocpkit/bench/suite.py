@@ -11,7 +11,9 @@ Scenario sources:
   `scenarios/mbm/<robot>/<scene>/` next to the suite file or in its parent folder (the shipped subset), then in
   the cache folder of `ocpkit data mbm` (MBM_CACHE): the first of these that holds every problem asked for.
   Problem k (1-based) is the k-th file of the scene folder in natural order (problem2 before problem10); all of
-  the first folder's when `problems` is left out. Their scene is ROBOT/SCENE
+  the first folder's when `problems` is left out. Problems `ocpkit data mbm` found invalid for the robot model
+  (its invalid.txt: a start or goal in collision, as vamp's own evaluation finds and skips) are left out, and the
+  suite lists them (`Suite.left_out`). Their scene is ROBOT/SCENE
   (e.g. panda/cage: both robots have the same scenes and problem names).
 - `random`: `{robot: industrial6, count, seed, obstacles: [min, max]}`: ocpkit.bench.random.random_problems.
 """
@@ -119,12 +121,14 @@ class Method:
 
 @dataclass(frozen=True)
 class Suite:
-    """A checked suite: its name, scenarios, methods and repeats."""
+    """A checked suite: its name, scenarios, methods and repeats; `left_out`: the MBM problems asked for whose start or
+    goal the robot model rejects, each "file: reason" (module docstring)."""
 
     name: str
     scenarios: tuple[Scenario, ...]
     methods: tuple[Method, ...]
     repeats: int = 1
+    left_out: tuple[str, ...] = ()
 
 
 def load_suite(path: str | Path) -> Suite:
@@ -134,12 +138,13 @@ def load_suite(path: str | Path) -> Suite:
     with within(path):
         data = read_yaml(text, SuiteError)
         check(data, SUITE, SuiteError)
-        scenarios = [s for k, source in enumerate(data["scenarios"])
-                     for s in _resolve(source, path.parent, f"scenarios[{k}]")]
+        resolved = [_resolve(source, path.parent, f"scenarios[{k}]") for k, source in enumerate(data["scenarios"])]
         methods = [_method(m, f"methods[{k}]") for k, m in enumerate(data["methods"])]
+    scenarios = [s for found, _ in resolved for s in found]
     _unique([(s.scene, s.case) for s in scenarios], "scenario (scene, case)")
     _unique([m.label for m in methods], "method label")
-    return Suite(data.get("name", path.stem), tuple(scenarios), tuple(methods), data.get("repeats", 1))
+    return Suite(data.get("name", path.stem), tuple(scenarios), tuple(methods), data.get("repeats", 1),
+                 tuple(line for _, left_out in resolved for line in left_out))
 
 
 def _unique(names: list, what: str) -> None:
@@ -150,9 +155,12 @@ def _unique(names: list, what: str) -> None:
         seen.add(name)
 
 
-def _resolve(source: dict, base: Path, where: str) -> list[Scenario]:
+def _resolve(source: dict, base: Path, where: str) -> tuple[list[Scenario], list[str]]:
+    """The scenarios of one source, and the problems it left out ("file: reason")."""
     kind, body = next(iter(source.items()))
-    return {"paths": _paths, "mbm": _mbm, "random": _random}[kind](body, base, f"{where}.{kind}")
+    if kind == "mbm":
+        return _mbm(body, base, f"{where}.{kind}")
+    return {"paths": _paths, "random": _random}[kind](body, base, f"{where}.{kind}"), []
 
 
 def _paths(patterns: list[str], base: Path, where: str) -> list[Scenario]:
@@ -189,8 +197,8 @@ def _natural(path: Path) -> list:
     return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", path.name)]
 
 
-def _mbm(body: dict, base: Path, where: str) -> list[Scenario]:
-    scenarios = []
+def _mbm(body: dict, base: Path, where: str) -> tuple[list[Scenario], list[str]]:
+    scenarios, left_out = [], []
     for scene in body["scenes"]:
         folders = mbm_folders(body["robot"], scene, base)
         found = [files for f in folders if (files := sorted(f.glob("*.yaml"), key=_natural))]
@@ -204,8 +212,28 @@ def _mbm(body: dict, base: Path, where: str) -> list[Scenario]:
             raise SuiteError(f"{where}.problems[{k}]: problem {numbers[k]} does not exist: the most problems found "
                              f"for {body['robot']}/{scene} are {max(map(len, found))} (in "
                              f"{', '.join(map(str, folders))}); `ocpkit data mbm` converts all of them")
-        scenarios += [_from_file(files[number - 1], f"{body['robot']}/{scene}") for number in numbers]
-    return scenarios
+        rejected = _rejected(files[0].parent)
+        for number in numbers:
+            file = files[number - 1]
+            if file.name in rejected:
+                left_out.append(f"{file}: {rejected[file.name]}")
+            else:
+                scenarios.append(_from_file(file, f"{body['robot']}/{scene}"))
+    return scenarios, left_out
+
+
+def _rejected(scene: Path) -> dict[str, str]:
+    """File name → reason of the problems of the scene folder `scene` that `ocpkit data mbm` found invalid for its
+    robot model (listed in the robot folder's invalid.txt as "path: reason"); none for the shipped subset."""
+    listed = scene.parent / "invalid.txt"
+    if not listed.is_file():
+        return {}
+    rejected = {}
+    for line in listed.read_text().splitlines():
+        file, _, reason = line.partition(": ")
+        if Path(file).parent.name == scene.name:
+            rejected[Path(file).name] = reason
+    return rejected
 
 
 def _random(body: dict, base: Path, where: str) -> list[Scenario]:

@@ -177,6 +177,10 @@ def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_p
     for k in range(1, 5):
         (cached / f"{k:04d}.yaml").write_text(text)
     assert [s.case for s in load_suite(tmp_path / "suites/s.yaml").scenarios] == ["0004"]  # from `ocpkit data mbm`
+    (tmp_path / "cache/panda/invalid.txt").write_text(f"{cached / '0004.yaml'}: goal configuration is in collision\n"
+                                                      f"{tmp_path / 'cache/panda/box/0004.yaml'}: start ...\n")
+    suite = load_suite(tmp_path / "suites/s.yaml")  # as vamp's evaluation, problems invalid for the model are left out
+    assert suite.scenarios == () and suite.left_out == (f"{cached / '0004.yaml'}: goal configuration is in collision",)
 
 
 def test_random_source_and_repeats_give_seeded_problems_and_seeds(tmp_path):
