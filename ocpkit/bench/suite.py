@@ -13,8 +13,8 @@ Scenario sources:
   Problem k (1-based) is the k-th file of the scene folder in natural order (problem2 before problem10); all of
   the first folder's when `problems` is left out. Problems `ocpkit data mbm` found invalid for the robot model
   (its invalid.txt: a start or goal in collision, as vamp's own evaluation finds and skips) are left out, and the
-  suite lists them (`Suite.left_out`). Their scene is ROBOT/SCENE
-  (e.g. panda/cage: both robots have the same scenes and problem names).
+  suite lists them (`Suite.left_out`). Their scene is ROBOT/SCENE (e.g. panda/cage: both robots have the same
+  scenes and problem names).
 - `random`: `{robot: industrial6, count, seed, obstacles: [min, max]}`: ocpkit.bench.random.random_problems.
 """
 
