@@ -9,8 +9,8 @@ and — verification always checks every term densely — keeps a verified plan 
 motion comes within MISSING_DISTANCE of a term left out is solved again, warm-started, with the terms near it
 added (a rebuild, part of the computation time), at most MAX_REBUILDS times; such a motion also ends the
 refinement rounds at once (ocpkit.refine), since rounds on an NLP without those rows cannot fix it (before, a
-capped rung spent its iterations on them and ended `violated`, the rows still missing). Below SCREEN_ABOVE (the paper's
-robot: 75 terms) the NLP keeps every term within reach, as before.
+capped rung spent its iterations on them and ended `violated`, the rows still missing). Below SCREEN_ABOVE (the
+paper's robot: 75 terms) the NLP keeps every term within reach, as before.
 """
 
 from __future__ import annotations

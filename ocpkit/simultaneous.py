@@ -166,20 +166,25 @@ def _build(problem: Problem, options: dict, near: np.ndarray | None) -> Build:
 
 
 def _lacking(problem: Problem, made: Build, near: np.ndarray | None) -> Callable[[Trajectory], bool] | None:
-    """With screening (`near` given): whether a motion comes near rows `made` left out (ocpkit.screening), which
-    ends its refinement rounds so the plan rebuilds with them instead; None without screening."""
+    """With screening (`near` given): whether a motion comes near rows `made` left out, which ends its refinement
+    rounds so the plan rebuilds with them instead; None without screening."""
     if near is None:
         return None
-    return lambda motion: screening.missing(problem, made.discretization.constraints,
-                                            screening.motion_samples(motion)) > 0
+    return lambda motion: _near_left_out(problem, made, motion) is not None
+
+
+def _near_left_out(problem: Problem, made: Build, motion: Trajectory) -> np.ndarray | None:
+    """Samples (K, n) of `motion` when it comes near rows `made` left out (ocpkit.screening), else None."""
+    samples = screening.motion_samples(motion)
+    return samples if screening.missing(problem, made.discretization.constraints, samples) else None
 
 
 def _widened(problem: Problem, options: dict, made: Build, near: np.ndarray,
              motion: Trajectory) -> tuple[Build, np.ndarray] | None:
-    """The rebuild screened by `near` and samples of `motion` when `motion` comes near rows `made` left out
-    (ocpkit.screening), with those configurations (K, n); None when it does not."""
-    samples = screening.motion_samples(motion)
-    if not screening.missing(problem, made.discretization.constraints, samples):
+    """The rebuild screened by `near` and samples of `motion` when `motion` comes near rows `made` left out, with
+    those configurations (K, n); None when it does not."""
+    samples = _near_left_out(problem, made, motion)
+    if samples is None:
         return None
     near = np.vstack([near, samples])
     return _build(problem, options, near), near

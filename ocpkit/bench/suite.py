@@ -158,13 +158,11 @@ def _unique(names: list, what: str) -> None:
 def _resolve(source: dict, base: Path, where: str) -> tuple[list[Scenario], list[str]]:
     """The scenarios of one source, and the problems it left out ("file: reason")."""
     kind, body = next(iter(source.items()))
-    if kind == "mbm":
-        return _mbm(body, base, f"{where}.{kind}")
-    return {"paths": _paths, "random": _random}[kind](body, base, f"{where}.{kind}"), []
+    return {"paths": _paths, "mbm": _mbm, "random": _random}[kind](body, base, f"{where}.{kind}")
 
 
-def _paths(patterns: list[str], base: Path, where: str) -> list[Scenario]:
-    """The scenario files matching `patterns` (relative to `base`), each pattern's matches sorted."""
+def _paths(patterns: list[str], base: Path, where: str) -> tuple[list[Scenario], list[str]]:
+    """The scenario files matching `patterns` (relative to `base`), each pattern's matches sorted; none left out."""
     files = []
     for k, pattern in enumerate(patterns):
         matches = sorted(glob.glob(str(base / pattern))) if glob.has_magic(pattern) else [str(base / pattern)]
@@ -172,7 +170,7 @@ def _paths(patterns: list[str], base: Path, where: str) -> list[Scenario]:
         if not matches:
             raise SuiteError(f"{where}[{k}]: no scenario file matches {show(pattern)} (relative to {base})")
         files += [Path(m) for m in matches]
-    return [_from_file(f, f.parent.name) for f in files]
+    return [_from_file(f, f.parent.name) for f in files], []
 
 
 def _from_file(file: Path, scene: str) -> Scenario:
@@ -236,7 +234,7 @@ def _rejected(scene: Path) -> dict[str, str]:
     return rejected
 
 
-def _random(body: dict, base: Path, where: str) -> list[Scenario]:
+def _random(body: dict, base: Path, where: str) -> tuple[list[Scenario], list[str]]:
     from ocpkit.bench.random import _scenario as scenario_data  # the random suite's own file content
     from ocpkit.bench.random import random_problems
 
@@ -244,7 +242,7 @@ def _random(body: dict, base: Path, where: str) -> list[Scenario]:
     if low_high[0] > low_high[1]:
         raise SuiteError(f"{where}.obstacles needs [min, max] with min ≤ max, got {show(list(low_high))}")
     scene = f"random-seed{seed}"
-    return [Scenario(p.name, scene, scenario_data(p)) for p in random_problems(seed, body["count"], low_high)]
+    return [Scenario(p.name, scene, scenario_data(p)) for p in random_problems(seed, body["count"], low_high)], []
 
 
 def _planner_parameters(planner: str) -> list[str]:
