@@ -11,7 +11,9 @@ against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP 
   friction(q̇) and dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈) from the interpolant's slopes du/ds and
   dẍ/ds (`Slope`), where dt/ds is the transcription's (t_f/(2K) on a pseudospectral segment, h = t_f/N on a
   mesh interval), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f never divides;
-- the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base);
+- the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base),
+  through one CasADi Function per constraint of a symbolic point, made once and inlined at every point (running a
+  constraint's Python code point by point was most of the graph construction time);
 - the OCP's rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) = 0);
 - the robot's jerk times dt/ds at a point (`jerk_s`), which the jerk cost integrates;
 - the rows lbg ≤ g ≤ ubg in the order they were added, and the finished `NLP`.
@@ -19,6 +21,7 @@ against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 import casadi as ca
@@ -48,6 +51,7 @@ class Assembly:
         self.ocp.use_parameters({name: self.p.add(f"ocp.{name}", *shape)
                                  for name, shape in self.ocp.parameter_shapes().items()})
         self._torque = self.ocp.torque(dynamics)
+        self._point_rows: dict[int, tuple[ca.Function, np.ndarray, np.ndarray]] = {}
         self.g: list[ca.SX] = []
         self.lbg: list[np.ndarray] = []
         self.ubg: list[np.ndarray] = []
@@ -104,9 +108,9 @@ class Assembly:
         one-sided slope in `slopes` (none without slopes)."""
         first, *others = [self.point(x, slope, dt_ds) for slope in slopes] or [
             self.point(x, Slope(ca.SX.zeros(self.ocp.algebraic), ca.SX.zeros(self.ocp.chain)), dt_ds)]
-        for constraint, context in zip(self.constraints, self.contexts):
+        for index, constraint in enumerate(self.constraints):
             if _imposed(constraint, bool(slopes), at_knot and self.ocp.knot_bounds):
-                self.add(constraint.evaluate(first, context))
+                self.add(self._evaluate(index, first))
         for values in others:
             self._rates(values)
 
@@ -116,9 +120,21 @@ class Assembly:
             self._rates(self.point(x, slope, dt_ds))
 
     def _rates(self, values: PointValues) -> None:
-        for constraint, context in zip(self.constraints, self.contexts):
+        for index, constraint in enumerate(self.constraints):
             if constraint.reads_rate:
-                self.add(constraint.evaluate(values, context))
+                self.add(self._evaluate(index, values))
+
+    def _evaluate(self, index: int, values: PointValues) -> Rows:
+        """Constraint `index`'s rows at one point, through one CasADi Function of a symbolic point made on first
+        use: the constraint's Python code runs once per NLP instead of once per point (the calls are inlined)."""
+        if index not in self._point_rows:
+            point = PointValues(*(ca.SX.sym(field.name, *getattr(values, field.name).shape)
+                                  for field in dataclasses.fields(PointValues)))
+            rows = self.constraints[index].evaluate(point, self.contexts[index])
+            inputs = [*_point_fields(point), *_context_symbols(self.contexts[index])]
+            self._point_rows[index] = ca.Function("point_rows", inputs, [rows.g]), rows.lower, rows.upper
+        function, lower, upper = self._point_rows[index]
+        return Rows(function(*_point_fields(values), *_context_symbols(self.contexts[index])), lower, upper)
 
     # -- the result ----------------------------------------------------------------------------------
     def nlp(self, f: ca.SX, shape_key: tuple, stages: Stages | None = None) -> NLP:
@@ -126,6 +142,16 @@ class Assembly:
         fields = self.dynamics.lift({"x": self.w.symbol(), "p": self.p.symbol(), "f": f, "g": ca.vertcat(*self.g)})
         return NLP(fields["x"], fields["p"], fields["f"], fields["g"], np.concatenate(self.lbg),
                    np.concatenate(self.ubg), self.w, self.p, shape_key, fields.get("exact_hessian", True), stages)
+
+
+def _point_fields(values: PointValues) -> tuple:
+    """The fields of `values` in order (dataclasses.astuple would deep-copy the CasADi expressions)."""
+    return tuple(getattr(values, field.name) for field in dataclasses.fields(PointValues))
+
+
+def _context_symbols(context: Context) -> list[ca.SX]:
+    """The NLP parameter symbols a constraint may read: margin, limit_scale and its own parameters."""
+    return [context.margin, context.limit_scale, *context.parameters.values()]
 
 
 def _imposed(constraint: Constraint, with_rate: bool, at_knot: bool) -> bool:

@@ -5,8 +5,11 @@
 What is specific to the code: `Grid` maps a segment's local s to global σ; the knot columns run in decreasing
 time (column 0 is t_f, the last the start) and adjacent segments share their joint column; a joint's dynamics
 defect and non-rate path constraints come from the earlier segment in column order, its torque-rate rows once
-per segment's slope; q is lifted at the check points (`q_check`), the fixed ones per segment and the adaptive
-slots, whose interpolation rows are NLP parameters so a refinement moves them without a rebuild.
+per segment's slope; q, q̇ and q̈ are lifted at the check points (`q_check`, `qd_check`, `qdd_check`), the fixed
+ones per segment and the adaptive slots, whose interpolation rows are NLP parameters so a refinement moves them
+without a rebuild. Lifted, every nonlinear row at a check point reads that point's own variables: a nonlinear
+function of the interpolating combination of all knots (friction(L q̇) in a torque row) would make its Hessian
+block dense in every knot, which CasADi pays for when it builds the Hessian and IPOPT in every factorization.
 
 Equations: docs/transcription.md, section "Pseudospectral"; the check points: section "Why constraints are
 also imposed between knots".
@@ -30,6 +33,11 @@ from ocpkit.transcription.assembly import Assembly, Node, Slope
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP
 from ocpkit.transcription.polynomials import NodeFamily
+
+
+CHECK_PARTS = ("q", "qd", "qdd")
+"""The chain parts lifted at the check points (as variables "q_check", "qd_check", "qdd_check" (m, checks)), so
+every nonlinear row there reads local variables only."""
 
 
 @dataclass(frozen=True)
@@ -91,9 +99,9 @@ def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
 
 class PseudospectralDiscretization(Discretization):
     """The NLP of `ocp` (one shape) on `grid` (docs/transcription.md), with the maps from a problem to its numbers
-    and back. Variables: knot columns "knot0".. in column order (named "X", "q", ... by the assembly), "q_check"
-    (m, checks: the chain's x), "tf"; own parameters "adaptive_rows", "adaptive_drows" (slots, KN + 1): L(σ_k)
-    and d/ds L(σ_k) of the adaptive check slots."""
+    and back. Variables: knot columns "knot0".. in column order (named "X", "q", ... by the assembly), "q_check",
+    "qd_check", "qdd_check" (m, checks: the chain's x, ẋ, ẍ), "tf"; own parameters "adaptive_rows",
+    "adaptive_drows" (slots, KN + 1): L(σ_k) and d/ds L(σ_k) of the adaptive check slots."""
 
     def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint], grid: Grid,
                  margin: float, adaptive_checks: int, shape_key: tuple, ocp: OCP, end_checks: bool = False) -> None:
@@ -108,7 +116,8 @@ class PseudospectralDiscretization(Discretization):
         a = Assembly(problem, dynamics, constraints, ocp)
         x = [a.node(f"knot{j}") for j in range(columns)]  # column j at σ_j: t_f first, the start last
         a.name_knots([f"knot{j}" for j in range(columns)], start=columns - 1, goal=0)
-        Qc = a.w.add("q_check", ocp.chain, len(self.check_sigma) + adaptive_checks)
+        checks = len(self.check_sigma) + adaptive_checks
+        Qc, Qdc, Qddc = (a.w.add(f"{part}_check", ocp.chain, checks) for part in CHECK_PARTS)
         tf = a.w.add("tf")
         rows = a.p.add("adaptive_rows", adaptive_checks, columns)  # L(σ_k), one row per slot
         drows = a.p.add("adaptive_drows", adaptive_checks, columns)  # d/ds L(σ_k)
@@ -138,8 +147,9 @@ class PseudospectralDiscretization(Discretization):
         Q, Qd, Qdd, U = (stack(x, part).T for part in Node._fields)  # (n, KN + 1)
         for k in range(L.size1()):
             row, drow = ca.transpose(L[k, :]), ca.transpose(Ld[k, :])
-            a.defect(Qc[:, k] - ca.mtimes(Q, row))
-            a.path(Node(Qc[:, k], ca.mtimes(Qd, row), ca.mtimes(Qdd, row), ca.mtimes(U, row)),
+            for lifted, values in zip((Qc, Qdc, Qddc), (Q, Qd, Qdd)):
+                a.defect(lifted[:, k] - ca.mtimes(values, row))
+            a.path(Node(Qc[:, k], Qdc[:, k], Qddc[:, k], ca.mtimes(U, row)),
                    [Slope(ca.mtimes(U, drow), ca.mtimes(Qdd, drow))], h)
 
         quad = ca.DM(np.kron(np.tile(weights, K), problem.jerk_weights))
@@ -163,7 +173,8 @@ class PseudospectralDiscretization(Discretization):
         knots, checks = at(self.grid.knots), at(np.concatenate([self.check_sigma, self.adaptive_default]))
         values = np.zeros(w.size)
         w.write(values, "X", self.ocp.columns(knots))
-        w.write(values, "q_check", checks.q.T)
+        for part in CHECK_PARTS:
+            w.write(values, f"{part}_check", getattr(checks, part).T)
         w.write(values, "tf", tf)
         return values
 

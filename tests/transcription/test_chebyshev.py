@@ -36,7 +36,7 @@ def test_dynamics_and_collocation_hold_exactly_on_a_polynomial_motion(disc):
     w = disc.encode(quintic(PROBLEM, 2.0))
     _, g = evaluate(disc, w, PROBLEM)
     equalities = nlp.lbg == nlp.ubg
-    assert equalities.sum() == (KNOTS + 1) * 3 * 6 + 6 * checks(disc)  # D Q, D Qd, dynamics; check-point q
+    assert equalities.sum() == (KNOTS + 1) * 3 * 6 + 3 * 6 * checks(disc)  # D Q, D Qd, dynamics; check q, qd, qdd
     assert np.abs(g[equalities]).max() < 1e-8
 
 

@@ -123,8 +123,8 @@ def test_equalities_vanish_exactly_on_motions_of_degree_n(setup, disc):
     nlp, equalities = disc.nlp, disc.nlp.lbg == disc.nlp.ubg
     checks = nlp.variables.index("q_check").shape[1]
     assert disc.grid.K == K and nlp.variables.index("X").shape == (columns(disc), 24)
-    # D Q, D Qd at the collocated points of every segment; dynamics once per column; lifted check q
-    assert equalities.sum() == 6 * (2 * K * collocated + (K * N + 1) + checks)
+    # D Q, D Qd at the collocated points of every segment; dynamics once per column; lifted check q, qd, qdd
+    assert equalities.sum() == 6 * (2 * K * collocated + (K * N + 1) + 3 * checks)
     for shape in (monomial(N), Polynomial([0.0, 0.3, -0.2, 0.9, 0.4, -0.3])):
         _, g = evaluate(disc, disc.encode(polynomial_motion(PROBLEM, TF, shape)), PROBLEM)
         assert np.abs(g[equalities]).max() < 1e-9, shape
