@@ -6,9 +6,8 @@ paper's cases: far slower than the optimum, so the first IPOPT iterations only s
 (quintic) rest-to-rest motion along the line needs to keep within the velocity limits, lengthened until its
 inverse-dynamics torque keeps within the torque limits.
 
-The simultaneous planner's default stays `paper`: the fallback ladder's solve rate on the hard random suite
-(README) was measured with it, and `line`, which saves a few iterations on the paper cases, has not been
-measured there yet.
+The simultaneous planner's default stays `paper`: `line` is faster on the paper cases, but it verified fewer of
+the shipped MBM problems and no more of the hard random suite (figures: docs/design-notes.md).
 """
 
 from __future__ import annotations

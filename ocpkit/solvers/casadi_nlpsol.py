@@ -204,8 +204,8 @@ class CasadiNlpsol(Solver):
 class Ipopt(CasadiNlpsol):
     """IPOPT with exact Hessian by CasADi AD (L-BFGS when the NLP has none) and the MUMPS linear solver;
     extra keyword options go to IPOPT verbatim (e.g. tol=1e-8). MUMPS starts without threshold pivoting
-    (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out inaccurate): on our KKT
-    systems that halves the factorization time and changes no outcome (docs/design-notes.md)."""
+    (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out inaccurate), which is
+    faster on our KKT systems (figures: docs/design-notes.md)."""
 
     name = plugin = "ipopt"
     statuses = {
