@@ -30,6 +30,8 @@ def test_rows_through_the_point_functions_equal_the_constraints_own():
     values = assembly.point(node, slope, dt_ds)
     own = [constraint.evaluate(values, context) for constraint, context in zip(constraints, assembly.contexts)]
     assert len(assembly.g) == len(own) and sum(rows.g.numel() for rows in own) > 100
+    collision = next(c for c in constraints if c.name == "collision")
+    assert collision.obstacle_mask[:, 1:].any(axis=0).all()  # the box and the cylinder have rows
     symbols = [assembly.w.symbol(), assembly.p.symbol(), slope.u, slope.xdd, dt_ds]
     both = ca.Function("both", symbols, [ca.vertcat(*assembly.g), ca.vertcat(*(rows.g for rows in own))])
     rng = np.random.default_rng(0)
