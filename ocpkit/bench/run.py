@@ -8,11 +8,7 @@ Ctrl-C keeps the finished rows (the command exits 130); the progress bar shows t
 from __future__ import annotations
 
 import csv
-import multiprocessing
-import signal
-from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from concurrent.futures.process import BrokenProcessPool
+from collections.abc import Iterator
 from pathlib import Path
 
 import yaml
@@ -22,7 +18,8 @@ from ocpkit.bench.common import Results, reported_on_interrupt, resumed_line
 from ocpkit.bench.metrics import formatted, summarize
 from ocpkit.bench.suite import load_suite
 from ocpkit.bench.task import RUN_COLUMNS, RUN_KEY_COLUMNS, make_task, run_task, task_key
-from ocpkit.errors import OptionError, WorkerDied
+from ocpkit.bench.workers import in_processes
+from ocpkit.errors import OptionError
 
 CONNECT_TIMEOUT = "20s"
 """How long to wait for a Dask scheduler before giving up."""
@@ -99,34 +96,9 @@ def _outcomes(tasks: list[dict], jobs: int, scheduler: str | None) -> Iterator[d
     if scheduler:
         yield from _on_dask(tasks, scheduler)
     elif jobs > 1 and len(tasks) > 1:
-        yield from _in_processes(tasks, min(jobs, len(tasks)))
+        yield from in_processes(tasks, jobs, run_task)
     else:
         yield from map(run_task, tasks)
-
-
-def _in_processes(tasks: list[dict], workers: int, work: Callable[[dict], dict] = run_task) -> Iterator[dict]:
-    """`work`'s (run_task's) outcomes from `workers` spawned processes (no forked copies of solver threads), as
-    they finish. A worker that dies (killed by the system, e.g. out of memory) ends the run with WorkerDied
-    instead of leaving its task unfinished forever; leaving early (Ctrl-C, an error) terminates the workers at
-    once."""
-    pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=_ignore_interrupt)
-    try:
-        for future in as_completed([pool.submit(work, task) for task in tasks]):
-            try:
-                yield future.result()
-            except BrokenProcessPool:
-                raise WorkerDied("a worker process died before finishing its plan (killed by the system: out of "
-                                 "memory?); the finished rows are kept: run the same command again to resume, "
-                                 "with fewer --jobs if memory is short") from None
-    finally:
-        for process in list((pool._processes or {}).values()):  # the executor has no public way to stop them
-            process.terminate()
-        pool.shutdown(wait=False, cancel_futures=True)
-
-
-def _ignore_interrupt() -> None:
-    """In a worker process: leave Ctrl-C to the main process, which stops the pool."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _on_dask(tasks: list[dict], scheduler: str) -> Iterator[dict]:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import csv
 import math
-import os
 import shutil
 import signal
 import subprocess
@@ -16,11 +15,10 @@ from pathlib import Path
 import pytest
 from helpers import REPO
 
-from ocpkit.bench.run import _in_processes, run_suite
+from ocpkit.bench.run import run_suite
 from ocpkit.bench import suite as suite_module
 from ocpkit.bench.suite import SuiteError, load_suite
 from ocpkit.cli import main
-from ocpkit.errors import WorkerDied
 
 TIMINGS = ("solve_time_s", "setup_time_s", "wall_time_s", "extra")  # extra holds the baseline's stage times
 SUITE = f"""name: small
@@ -278,19 +276,3 @@ def test_a_planner_that_raises_gives_a_failed_row_naming_the_exception_not_a_cra
     assert row["status"] == "failed" and row["method"] == "ompl-toppra"
     assert json.loads(row["extra"])["error"] == "ompl-toppra raised ZeroDivisionError: a planner bug"
     assert json.loads(outcome["trajectory"])["status"] == "failed"
-
-
-def _killed(task: dict) -> dict:
-    """A plan whose worker process the system kills (as the out-of-memory killer does)."""
-    if task["die"]:
-        os.kill(os.getpid(), signal.SIGKILL)
-    time.sleep(0.2)
-    return {"row": task}
-
-
-def test_a_worker_killed_by_the_system_ends_the_run_with_an_error_not_a_hang():
-    outcomes = _in_processes([{"die": False}, {"die": True}, {"die": False}], 2, work=_killed)
-    started = time.perf_counter()
-    with pytest.raises(WorkerDied, match="worker process died"):
-        list(outcomes)
-    assert time.perf_counter() - started < 60
