@@ -81,12 +81,26 @@ class Stages:
 
 
 @dataclass(frozen=True)
+class PointCall:
+    """Rows first_row, first_row + 1, ... of an NLP's g that are `function(*inputs, *parameters)`: one point
+    function (one constraint or the dynamics at one point) at that point's `inputs` (expressions of x and p,
+    differentiated) and `parameters` (symbols of p, not differentiated)."""
+
+    function: ca.Function
+    inputs: tuple[ca.SX, ...]
+    parameters: tuple[ca.SX, ...]
+    first_row: int
+
+
+@dataclass(frozen=True)
 class NLP:
     """x: decision column (n_w), p: parameter column (n_p), f: objective, g: constraint column (n_g) with
     numeric bounds lbg ≤ g ≤ ubg; `variables` and `parameters` name the parts of x and p. `shape_key` is
     equal for NLPs that are identical up to the numbers in p and the bounds; `exact_hessian` is False when
     a dynamics backend gives first derivatives only; `stages` is set when the rows and variables follow a
-    stage structure."""
+    stage structure; `point_calls` lists the rows that are point functions of few inputs, and `objective_call`
+    gives f that way (its first_row unused), so their derivatives can be built point by point
+    (ocpkit.solvers.pointwise)."""
 
     x: ca.SX | ca.MX
     p: ca.SX | ca.MX
@@ -99,6 +113,8 @@ class NLP:
     shape_key: tuple
     exact_hessian: bool = True
     stages: Stages | None = None
+    point_calls: tuple[PointCall, ...] = ()
+    objective_call: PointCall | None = None
 
 
 @dataclass(frozen=True)

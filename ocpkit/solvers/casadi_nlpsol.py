@@ -30,6 +30,7 @@ import numpy as np
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP, Stages
+from ocpkit.solvers.pointwise import pointwise_derivatives
 from ocpkit.solvers.base import (BOUND_TOLERANCE, PreparedSolver, Solver, SolverResult, SolverStatus, bound_slack,
                                  time_limit)
 
@@ -202,7 +203,9 @@ class CasadiNlpsol(Solver):
 
 
 class Ipopt(CasadiNlpsol):
-    """IPOPT with exact Hessian by CasADi AD (L-BFGS when the NLP has none) and the MUMPS linear solver;
+    """IPOPT with exact Hessian by CasADi AD (L-BFGS when the NLP has none) and the MUMPS linear solver; the
+    constraint Jacobian and the Hessian are built point by point where the NLP has point calls
+    (ocpkit.solvers.pointwise: the same values, a fraction of the set-up);
     extra keyword options go to IPOPT verbatim (e.g. tol=1e-8). MUMPS starts without threshold pivoting
     (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out inaccurate), which is
     faster on our KKT systems (figures: docs/design-notes.md)."""
@@ -224,7 +227,8 @@ class Ipopt(CasadiNlpsol):
                         "mu_strategy": "adaptive", "mumps_pivtol": 0.0, "max_iter": max_iterations, **ipopt_options}
 
     def plugin_options(self, nlp: NLP) -> dict:
-        return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}}
+        derivatives = pointwise_derivatives(nlp) if nlp.point_calls and nlp.exact_hessian else {}
+        return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}, **derivatives}
 
 
 _QPSOL_QUIET = {"qpoases": {"printLevel": "none"}, "osqp": {"osqp": {"verbose": False}}}

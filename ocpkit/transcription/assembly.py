@@ -14,22 +14,26 @@ against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP 
 - the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base),
   through one CasADi Function per constraint of a symbolic point, made once and inlined at every point (running a
   constraint's Python code point by point was most of the graph construction time);
-- the OCP's rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) = 0);
-- the robot's jerk times dt/ds at a point (`jerk_s`), which the jerk cost integrates;
+- the OCP's rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) = 0), also
+  through one Function of a symbolic node where the dynamics backend is symbolic (exact second derivatives);
+- a record of those point Functions' rows (`NLP.point_calls`), from which IPOPT's derivatives are built point by
+  point (ocpkit.solvers.pointwise);
+- the robot's jerk times dt/ds at a point (`jerk_s`), which the jerk cost integrates; the objective, through a
+  Function of its inputs where the transcription gives it so (`objective`);
 - the rows lbg ≤ g ≤ ubg in the order they were added, and the finished `NLP`.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import casadi as ca
 import numpy as np
 
 from ocpkit.constraints import Constraint, Context, PointValues, Rows
 from ocpkit.dynamics import Dynamics
-from ocpkit.nlp import NLP, Layout, Stages
+from ocpkit.nlp import NLP, Layout, PointCall, Stages
 from ocpkit.problem import Problem
 from ocpkit.transcription.ocp import OCP, Node, RobotOCP, Slope
 
@@ -48,10 +52,16 @@ class Assembly:
         self.contexts = [Context(dynamics, margin, limit_scale, {
             name: self.p.add(f"{c.name}.{name}", *shape) for name, shape in c.parameter_shapes().items()})
             for c in self.constraints]
-        self.ocp.use_parameters({name: self.p.add(f"ocp.{name}", *shape)
-                                 for name, shape in self.ocp.parameter_shapes().items()})
+        ocp_parameters = {name: self.p.add(f"ocp.{name}", *shape)
+                          for name, shape in self.ocp.parameter_shapes().items()}
+        self.ocp.use_parameters(ocp_parameters)
+        self._ocp_parameters = tuple(ocp_parameters.values())
         self._torque = self.ocp.torque(dynamics)
         self._point_rows: dict[int, tuple[ca.Function, np.ndarray, np.ndarray]] = {}
+        self._defect: ca.Function | None = None
+        self._defect_by_function = getattr(dynamics, "exact_hessian", True)  # a callback backend records its calls
+        self.point_calls: list[PointCall] = []
+        self.objective_call: PointCall | None = None
         self.g: list[ca.SX] = []
         self.lbg: list[np.ndarray] = []
         self.ubg: list[np.ndarray] = []
@@ -91,11 +101,26 @@ class Assembly:
 
     def dynamics_defect(self, x: Node) -> None:
         """The OCP's rows at one collocation point (`OCP.defect`: the dynamics for the robot OCP) = 0."""
-        self.defect(self.ocp.defect(self.dynamics, x))
+        if not self._defect_by_function:
+            self.defect(self.ocp.defect(self.dynamics, x))
+            return
+        if self._defect is None:
+            node = Node(*(ca.SX.sym(name, *value.shape) for name, value in zip(Node._fields, x)))
+            self._defect = ca.Function("defect", [*node, *self._ocp_parameters],
+                                       [self.ocp.defect(self.dynamics, node)])
+        self._call(self._defect, tuple(x), self._ocp_parameters, 0.0, 0.0)
 
     def jerk_s(self, x: Node, dxdd_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
         """The robot's jerk times dt/ds (n, 1) at a point where the chain's ẍ has slope dẍ/ds = `dxdd_ds`."""
         return self.ocp.jerk_s(x, dxdd_ds, dt_ds)
+
+    def objective(self, formula: Callable[..., ca.SX], inputs: Sequence[ca.SX], parameters: Sequence[ca.SX]) -> ca.SX:
+        """The objective formula(*inputs, *parameters) (inputs: expressions of w and p; parameters: symbols of p),
+        through one Function of symbolic inputs, recorded as the NLP's objective call."""
+        symbols = [ca.SX.sym(f"input{i}", *value.shape) for i, value in enumerate(inputs)]
+        function = ca.Function("objective", [*symbols, *parameters], [formula(*symbols, *parameters)])
+        self.objective_call = PointCall(function, tuple(inputs), tuple(parameters), 0)
+        return function(*inputs, *parameters)
 
     def point(self, x: Node, slope: Slope, dt_ds: ca.SX) -> PointValues:
         """Values at one point where the interpolant has the slopes `slope` (du/ds, dẍ/ds)."""
@@ -110,7 +135,7 @@ class Assembly:
             self.point(x, Slope(ca.SX.zeros(self.ocp.algebraic), ca.SX.zeros(self.ocp.chain)), dt_ds)]
         for index, constraint in enumerate(self.constraints):
             if _imposed(constraint, bool(slopes), at_knot and self.ocp.knot_bounds):
-                self.add(self._evaluate(index, first))
+                self._constraint(index, first)
         for values in others:
             self._rates(values)
 
@@ -122,9 +147,9 @@ class Assembly:
     def _rates(self, values: PointValues) -> None:
         for index, constraint in enumerate(self.constraints):
             if constraint.reads_rate:
-                self.add(self._evaluate(index, values))
+                self._constraint(index, values)
 
-    def _evaluate(self, index: int, values: PointValues) -> Rows:
+    def _constraint(self, index: int, values: PointValues) -> None:
         """Constraint `index`'s rows at one point, through one CasADi Function of a symbolic point made on first
         use: the constraint's Python code runs once per NLP instead of once per point (the calls are inlined)."""
         if index not in self._point_rows:
@@ -134,14 +159,22 @@ class Assembly:
             inputs = [*_point_fields(point), *_context_symbols(self.contexts[index])]
             self._point_rows[index] = ca.Function("point_rows", inputs, [rows.g]), rows.lower, rows.upper
         function, lower, upper = self._point_rows[index]
-        return Rows(function(*_point_fields(values), *_context_symbols(self.contexts[index])), lower, upper)
+        self._call(function, _point_fields(values), tuple(_context_symbols(self.contexts[index])), lower, upper)
+
+    def _call(self, function: ca.Function, inputs: tuple, parameters: tuple, lower, upper) -> None:
+        """The rows lower ≤ function(*inputs, *parameters) ≤ upper, recorded as a point call."""
+        self.point_calls.append(PointCall(function, inputs, parameters, self.row_count))
+        self.add(Rows(function(*inputs, *parameters), lower, upper))
 
     # -- the result ----------------------------------------------------------------------------------
     def nlp(self, f: ca.SX, shape_key: tuple, stages: Stages | None = None) -> NLP:
         """The finished NLP with objective f, as the dynamics backend hands it to solvers (`Dynamics.lift`)."""
-        fields = self.dynamics.lift({"x": self.w.symbol(), "p": self.p.symbol(), "f": f, "g": ca.vertcat(*self.g)})
+        g = ca.vertcat(*self.g)
+        fields = self.dynamics.lift({"x": self.w.symbol(), "p": self.p.symbol(), "f": f, "g": g})
+        unchanged = fields["g"] is g  # a lifted (MX) NLP has no SX point calls
         return NLP(fields["x"], fields["p"], fields["f"], fields["g"], np.concatenate(self.lbg),
-                   np.concatenate(self.ubg), self.w, self.p, shape_key, fields.get("exact_hessian", True), stages)
+                   np.concatenate(self.ubg), self.w, self.p, shape_key, fields.get("exact_hessian", True), stages,
+                   tuple(self.point_calls) if unchanged else (), self.objective_call if unchanged else None)
 
 
 def _point_fields(values: PointValues) -> tuple:

@@ -153,7 +153,8 @@ class PseudospectralDiscretization(Discretization):
                    [Slope(ca.mtimes(U, drow), ca.mtimes(Qdd, drow))], h)
 
         quad = ca.DM(np.kron(np.tile(weights, K), problem.jerk_weights))
-        objective = tf + a.mu * (2.0 * K / tf) * ca.dot(quad, ca.vertcat(*jerk_s) ** 2)
+        objective = a.objective(lambda jerks, t_f, mu: t_f + mu * (2.0 * K / t_f) * ca.dot(quad, jerks ** 2),
+                                [ca.vertcat(*jerk_s), tf], [a.mu])
         super().__init__(a.nlp(objective, shape_key), constraints, margin, ocp)
 
     # -- numbers for one problem -------------------------------------------------------------------

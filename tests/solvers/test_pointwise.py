@@ -1,0 +1,76 @@
+"""IPOPT's derivatives built point by point (ocpkit.solvers.pointwise) against CasADi's own Jacobian and Hessian of
+the same NLP, at random points, for every transcription family, a scene with spheres, a box and a cylinder, the
+path-timing OCP (whose point inputs are not linear in w) and a robot with friction."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import casadi as ca
+import numpy as np
+import pytest
+from helpers import REPO
+
+from ocpkit import load_scenario
+from ocpkit.constraints import make_constraints
+from ocpkit.dynamics import make_dynamics
+from ocpkit.path_spline import PathSpline
+from ocpkit.scene import Boxes, Cylinders
+from ocpkit.solvers.pointwise import pointwise_derivatives
+from ocpkit.transcription import TRANSCRIPTIONS
+from ocpkit.transcription.ocp import PathTimingOCP
+
+CASE = load_scenario(REPO / "scenarios/paper/case1.yaml")
+PROBLEM = dataclasses.replace(CASE, scene=dataclasses.replace(
+    CASE.scene, boxes=Boxes(np.array([[0.9, 0.3, 0.6]]), np.array([[0.2, 0.3, 0.4]]), np.eye(3)[None]),
+    cylinders=Cylinders(np.array([[0.8, -0.4, 0.7]]), np.array([0.1]), np.array([0.5]), np.eye(3)[None])))
+
+
+def _path_timing() -> PathTimingOCP:
+    waypoints = np.stack([CASE.start, (CASE.start + CASE.goal) / 2 + 0.3, CASE.goal])
+    lengths = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
+    return PathTimingOCP(CASE.robot, PathSpline.fit(lengths, waypoints))
+
+
+def _assert_same_derivatives(discretization, problem) -> None:
+    nlp = discretization.nlp
+    assert nlp.point_calls and nlp.exact_hessian
+    x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
+    lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g.numel())
+    reference = ca.Function("reference", [x, p, lam_f, lam_g], [
+        ca.jacobian(g, x), ca.triu(ca.hessian(lam_f * f + ca.dot(lam_g, g), x)[0])])
+    ours = pointwise_derivatives(nlp)
+    rng = np.random.default_rng(0)
+    w0, params = discretization.initial_guess(problem), discretization.parameters(problem)
+    for _ in range(3):
+        w = w0 + 0.1 * rng.standard_normal(w0.size)
+        lam = (rng.uniform(0.5, 2.0), rng.standard_normal(g.numel()))
+        jac_expected, hess_expected = (ca.densify(m).full() for m in reference(w, params, *lam))
+        values, jac = ours["jac_g"](w, params)
+        np.testing.assert_allclose(np.asarray(values).ravel(), ca.Function("g", [x, p], [g])(w, params).full().ravel())
+        np.testing.assert_allclose(ca.densify(jac).full(), jac_expected, rtol=1e-9, atol=1e-9)
+        hess = ca.densify(ours["hess_lag"](w, params, *lam)).full()
+        np.testing.assert_allclose(hess, hess_expected, rtol=1e-9, atol=1e-9 * np.abs(hess_expected).max())
+
+
+@pytest.mark.parametrize("transcription, options", [
+    ("chebyshev", {"knots": 8}), ("lgl", {"knots": 5, "segments": 2}), ("lgr", {"knots": 6}),
+    ("hermite-simpson", {"knots": 6}), ("trapezoidal", {"knots": 8})])
+def test_pointwise_derivatives_equal_casadis_own(transcription, options):
+    dynamics = make_dynamics("casadi-rnea", PROBLEM.robot)
+    discretization = TRANSCRIPTIONS.get(transcription)(**options).build(PROBLEM, dynamics, make_constraints(PROBLEM))
+    _assert_same_derivatives(discretization, PROBLEM)
+
+
+def test_pointwise_derivatives_with_inputs_not_linear_in_w():
+    """The path-timing OCP's state p(s), p′(s)ṡ, ... enters every point call: the chain rule's second-order term."""
+    dynamics = make_dynamics("casadi", CASE.robot)
+    constraints = make_constraints(CASE, ("state-limits", "torque", "torque-rate"))
+    discretization = TRANSCRIPTIONS.get("chebyshev")(knots=8).build(CASE, dynamics, constraints, _path_timing())
+    _assert_same_derivatives(discretization, CASE)
+
+
+def test_a_callback_backend_gives_no_point_calls():
+    dynamics = make_dynamics("pinocchio", CASE.robot)
+    discretization = TRANSCRIPTIONS.get("chebyshev")(knots=6).build(CASE, dynamics, make_constraints(CASE))
+    assert discretization.nlp.point_calls == () and discretization.nlp.objective_call is None
