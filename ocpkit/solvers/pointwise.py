@@ -3,8 +3,8 @@
 that are one point function's value).
 
 CasADi differentiates a whole graph at once, sweeping all of it once per colour of the Jacobian's columns; a
-Chebyshev row reads every knot of a joint, so there are several colours per knot, and those sweeps were nine
-tenths of the set-up. Here each distinct point function F(z) is differentiated once, on its own few inputs z,
+Chebyshev row reads every knot of a joint, so there are several colours per knot, and those sweeps were most of
+the set-up. Here each distinct point function F(z) is differentiated once, on its own few inputs z,
 and the chain rule joins the calls (Z stacks every call's z; λ_k weighs call k: its rows' multipliers, or λ_f):
 
     ∂g/∂x = blockdiag(∂F/∂z(z_k)) A,    A = ∂Z/∂x
@@ -25,7 +25,8 @@ from ocpkit.nlp import NLP, PointCall
 
 ROWS_AT_ONCE = 6
 """The other rows are differentiated this many consecutive rows at a time: rows added together read the same few
-knots, so each sweep covers a small graph (the whole at once needs as many sweeps over a graph 100× larger)."""
+knots, so each chunk needs few sweeps over a small graph, where all rows at once need as many sweeps over all of
+them (figures: docs/design-notes.md)."""
 
 
 def pointwise_derivatives(nlp: NLP) -> dict[str, ca.Function]:
