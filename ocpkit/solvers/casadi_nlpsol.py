@@ -30,9 +30,9 @@ import numpy as np
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP, Stages
-from ocpkit.solvers.pointwise import pointwise_derivatives
 from ocpkit.solvers.base import (BOUND_TOLERANCE, PreparedSolver, Solver, SolverResult, SolverStatus, bound_slack,
                                  time_limit)
+from ocpkit.solvers.pointwise import pointwise_derivatives
 
 _UNIFIED_STATUS = {
     "SOLVER_RET_SUCCESS": SolverStatus.CONVERGED,
