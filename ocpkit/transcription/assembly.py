@@ -105,7 +105,7 @@ class Assembly:
             self.defect(self.ocp.defect(self.dynamics, x))
             return
         if self._defect is None:
-            node = Node(*(ca.SX.sym(name, *value.shape) for name, value in zip(Node._fields, x)))
+            node = Node(*_symbols_like(x))
             self._defect = ca.Function("defect", [*node, *self._ocp_parameters],
                                        [self.ocp.defect(self.dynamics, node)])
         self._call(self._defect, tuple(x), self._ocp_parameters, 0.0, 0.0)
@@ -117,7 +117,7 @@ class Assembly:
     def objective(self, formula: Callable[..., ca.SX], inputs: Sequence[ca.SX], parameters: Sequence[ca.SX]) -> ca.SX:
         """The objective formula(*inputs, *parameters) (inputs: expressions of w and p; parameters: symbols of p),
         through one Function of symbolic inputs, recorded as the NLP's objective call."""
-        symbols = [ca.SX.sym(f"input{i}", *value.shape) for i, value in enumerate(inputs)]
+        symbols = _symbols_like(inputs)
         function = ca.Function("objective", [*symbols, *parameters], [formula(*symbols, *parameters)])
         self.objective_call = PointCall(function, tuple(inputs), tuple(parameters), 0)
         return function(*inputs, *parameters)
@@ -153,15 +153,15 @@ class Assembly:
         """Constraint `index`'s rows at one point, through one CasADi Function of a symbolic point made on first
         use: the constraint's Python code runs once per NLP instead of once per point (the calls are inlined)."""
         if index not in self._point_rows:
-            point = PointValues(*(ca.SX.sym(field.name, *getattr(values, field.name).shape)
-                                  for field in dataclasses.fields(PointValues)))
+            point = PointValues(*_symbols_like(_point_fields(values)))
             rows = self.constraints[index].evaluate(point, self.contexts[index])
             inputs = [*_point_fields(point), *_context_symbols(self.contexts[index])]
             self._point_rows[index] = ca.Function("point_rows", inputs, [rows.g]), rows.lower, rows.upper
         function, lower, upper = self._point_rows[index]
-        self._call(function, _point_fields(values), tuple(_context_symbols(self.contexts[index])), lower, upper)
+        self._call(function, _point_fields(values), _context_symbols(self.contexts[index]), lower, upper)
 
-    def _call(self, function: ca.Function, inputs: tuple, parameters: tuple, lower, upper) -> None:
+    def _call(self, function: ca.Function, inputs: tuple, parameters: tuple, lower: np.ndarray | float,
+              upper: np.ndarray | float) -> None:
         """The rows lower ≤ function(*inputs, *parameters) ≤ upper, recorded as a point call."""
         self.point_calls.append(PointCall(function, inputs, parameters, self.row_count))
         self.add(Rows(function(*inputs, *parameters), lower, upper))
@@ -182,9 +182,14 @@ def _point_fields(values: PointValues) -> tuple:
     return tuple(getattr(values, field.name) for field in dataclasses.fields(PointValues))
 
 
-def _context_symbols(context: Context) -> list[ca.SX]:
+def _context_symbols(context: Context) -> tuple[ca.SX, ...]:
     """The NLP parameter symbols a constraint may read: margin, limit_scale and its own parameters."""
-    return [context.margin, context.limit_scale, *context.parameters.values()]
+    return context.margin, context.limit_scale, *context.parameters.values()
+
+
+def _symbols_like(values: Sequence[ca.SX]) -> list[ca.SX]:
+    """New symbols of the shapes of `values`: the inputs of a point Function (made once, called at every point)."""
+    return [ca.SX.sym(f"input{i}", *value.shape) for i, value in enumerate(values)]
 
 
 def _imposed(constraint: Constraint, with_rate: bool, at_knot: bool) -> bool:
