@@ -51,6 +51,8 @@ def _planner_options(args: argparse.Namespace) -> dict:
              "guess": "guess", "refinements": "refinements", "seed": "seed",
              "max_wall_time": WALL_TIME_OPTION.get(args.planner, "max_wall_time")}
     given = {option: getattr(args, key) for key, option in names.items() if getattr(args, key) is not None}
+    if args.constraints is not None:
+        given["constraints"] = tuple(name.strip() for name in args.constraints.split(","))
     if args.segments is not None:
         given["transcription_options"] = {"segments": args.segments}
     if args.single_shot:
@@ -203,6 +205,7 @@ def parser() -> argparse.ArgumentParser:
     """The `ocpkit` argument parser; the component options list what the registries hold."""
     from ocpkit.bench.report_command import add_report_parser
     from ocpkit.bench.run_command import add_run_arguments
+    from ocpkit.constraints import CONSTRAINTS, DEFAULT_CONSTRAINTS
     from ocpkit.dynamics import DYNAMICS
     from ocpkit.planner import GUESSES, PLANNERS
     from ocpkit.solvers import SOLVERS
@@ -224,6 +227,9 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--dynamics", help=f"dynamics backend: {_names(DYNAMICS)} (default casadi-rnea)")
     p.add_argument("--solver", help=f"NLP solver: {_names(SOLVERS)} (default ipopt)")
     p.add_argument("--guess", help=f"initial guess: {_names(GUESSES)} (default paper)")
+    p.add_argument("--constraints", help="simultaneous: the path constraints, comma-separated names from "
+                   f"{_names(CONSTRAINTS)} (default {','.join(DEFAULT_CONSTRAINTS)}; add dynamics-consistency to "
+                   "bound the dynamics residual between knots too)")
     p.add_argument("--refinements", type=int, help="at most this many re-solve rounds after verification (default 5)")
     p.add_argument("--seed", type=int, help="OMPL's random seed (default 0): of ompl-toppra, or of the simultaneous "
                    "planner's --guess ompl")

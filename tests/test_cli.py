@@ -13,7 +13,7 @@ from helpers import REPO
 
 import ocpkit
 from ocpkit.build_cache import clear_builds
-from ocpkit.cli import main, parser
+from ocpkit.cli import _planner_options, main, parser
 from ocpkit.dynamics import DYNAMICS
 from ocpkit.errors import OptionError
 from ocpkit.planner import GUESSES, PLANNERS
@@ -46,7 +46,8 @@ def test_list_gives_each_constraint_its_docstring_line(capsys):
     main(["list"])
     out = capsys.readouterr().out
     constraints = out.split("constraints\n")[1].split("solvers\n")[0].splitlines()
-    assert [line.split()[0] for line in constraints] == ["collision", "state-limits", "torque", "torque-rate"]
+    assert [line.split()[0] for line in constraints] == ["collision", "dynamics-consistency", "state-limits",
+                                                                "torque", "torque-rate"]
     assert all(len(line.split()) > 1 for line in constraints)  # a description follows every name
 
 
@@ -68,6 +69,17 @@ def test_an_unknown_solver_lists_the_known_solvers(capsys):
     line = one_error_line(capsys)
     assert "'nope'" in line
     assert all(name in line for name in SOLVERS.names())
+
+
+def test_an_unknown_constraint_lists_the_known_constraints(capsys):
+    assert main(["plan", str(CASE2), "--knots", "6", "--constraints", "torque, nope"]) == 2
+    line = one_error_line(capsys)
+    assert "'nope'" in line and "dynamics-consistency" in line
+
+
+def test_constraints_reach_the_planner_as_a_tuple_of_names():
+    args = parser().parse_args(["plan", str(CASE2), "--constraints", "torque, collision,dynamics-consistency"])
+    assert _planner_options(args)["constraints"] == ("torque", "collision", "dynamics-consistency")
 
 
 def test_an_unknown_planner_is_a_one_line_error(capsys):

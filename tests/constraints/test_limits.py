@@ -104,8 +104,8 @@ def test_limit_constraints_read_no_parameters_and_have_no_shape():
         assert made.parameter_shapes() == {} and made.parameter_values(PROBLEM) == {} and made.shape() == ()
 
 
-def test_registry_holds_exactly_the_four_paper_constraints():
-    assert CONSTRAINTS.names() == sorted(["state-limits", "torque", "torque-rate", "collision"])
+def test_registry_holds_the_four_paper_constraints_as_defaults_and_the_dynamics_consistency():
+    assert CONSTRAINTS.names() == sorted(["state-limits", "torque", "torque-rate", "collision", "dynamics-consistency"])
     assert DEFAULT_CONSTRAINTS == ("state-limits", "torque", "torque-rate", "collision")
     assert [c.name for c in make_constraints(PROBLEM)] == list(DEFAULT_CONSTRAINTS)
     assert CONSTRAINTS.get("torque") is TorqueLimit
