@@ -26,8 +26,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ocpkit.baselines.ompl_toppra import (_hold, _import_backends, _no_path, _ompl_path, _smooth_path, _time_optimal,
-                                         check_ompl_planner, planning_space)
+from ocpkit.baselines.ompl_toppra import (MAX_STEP, _hold, _import_backends, _no_path, _ompl_path, _smooth_path,
+                                         _time_optimal, check_ompl_planner, planning_space)
 from ocpkit.build_cache import build
 from ocpkit.dynamics import Dynamics
 from ocpkit.path_spline import PathSpline
@@ -121,13 +121,13 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
                     solver_options: dict | None = None, dynamics_options: dict | None = None,
                     max_wall_time: float = 60.0, planner_name: str = "rrtconnect", planning_time: float = 1.0,
                     seed: int = 0, resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
-                    max_checks: int | None = None) -> Plan:
+                    max_checks: int | None = None, max_step: float | None = MAX_STEP) -> Plan:
     """Plan `problem` by OMPL path, quintic smoothing and optimal timing along the path (module docstring).
 
     The timing OCP's options are `plan_simultaneous`'s (`transcription`, `knots`, `dynamics`, `solver`,
     `refinements`, their option dicts; `max_wall_time` (s) bounds its solves); the path's are `plan_ompl_toppra`'s
-    (`planner_name`, `planning_time`, `seed`, `resolution`, `margin`, `max_checks`; `grid_points` for the TOPP-RA
-    warm start).
+    (`planner_name`, `planning_time`, `seed`, `resolution`, `margin`, `max_checks`, `max_step`; `grid_points` for the
+    TOPP-RA warm start).
 
     Status: the solver's when it did not converge, else "verified" or "violated"; "no_path" (OMPL found no exact
     path) holds the start."""
@@ -139,7 +139,7 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
         return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
     setup = _import_backends()
     free = planning_space(problem, margin)
-    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks)
+    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "margin_m": free.margin}
     if found.waypoints is None:
         return finish(problem, _hold(problem), "no_path", method, began, setup_time=setup, extra=extra, found=False,

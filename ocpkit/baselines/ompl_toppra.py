@@ -8,7 +8,9 @@ dense `verify`. Each step is one function below:
    a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
    The joint limits are the state-space bounds.
 2. `_ompl_path`: RRTConnect (or RRT*, BIT*, PRM) in joint space. A straight segment is checked, batched, at
-   configurations at most `resolution` rad apart (Euclidean over the joints). OMPL's PathSimplifier then
+   configurations at most `resolution` rad apart (Euclidean over the joints). An RRT extends at most `max_step`
+   rad at a time (MAX_STEP; OMPL's own default, a fifth of the joint box's diagonal, is 2.6 rad on the Panda and
+   6.2 rad on the UR5, and such long extensions into a cage or a shelf mostly fail). OMPL's PathSimplifier then
    shortens the path until it stops improving.
 3. `_smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
    tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
@@ -65,6 +67,7 @@ OMPL_PLANNERS = {"rrtconnect": "RRTConnect", "rrtstar": "RRTstar", "bitstar": "B
 REPAIR_ROUNDS = 8
 FRICTION_PASSES = 2
 TORQUE_RATE_WINDOW = 1e-3  # s
+MAX_STEP = 1.0  # rad: an RRT's longest extension (OMPL's `range`; module docstring, figures in README.md)
 SEGMENT_BATCH = 16  # configurations in the first batch checked along a segment; later batches double
 
 
@@ -202,10 +205,11 @@ class _OmplResult:
 
 
 def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
-               resolution: float, max_checks: int | None = None) -> _OmplResult:
-    """Plan start → goal with the named OMPL planner until it stops with an exact path, `planning_time` seconds
-    have passed or (if given) `free` has checked more than `max_checks` configurations, then simplify the path to
-    convergence. A budget in checks repeats on any machine; one in seconds does not.
+               resolution: float, max_checks: int | None = None, max_step: float | None = MAX_STEP) -> _OmplResult:
+    """Plan start → goal with the named OMPL planner (RRTs extending at most `max_step` rad) until it stops with an
+    exact path, `planning_time` seconds have passed or (if given) `free` has checked more than `max_checks`
+    configurations, then simplify the path to convergence. A budget in checks repeats on any machine; one in seconds
+    does not.
 
     The time budget is OMPL's own timer. A check budget is a Python condition, safe only for planners that plan in
     the calling thread (RRTConnect, RRT*, BIT*): PRM checks for a solution in a second thread, which would deadlock
@@ -214,6 +218,8 @@ def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_ti
     import ompl.geometric as og
     import ompl.util as ou
 
+    if max_step is not None and not (np.isfinite(max_step) and max_step > 0):
+        raise OptionError(f"max_step must be a finite number of radians > 0, got {max_step}")
     if max_checks is not None and planner_name == "prm":
         raise OptionError("max_checks cannot stop prm (it plans in a second thread); give it a planning_time")
     with _ompl_log_level(ou, ou.LOG_ERROR):
@@ -221,7 +227,7 @@ def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_ti
         si = _space_information(problem, free, resolution)
         setup = og.SimpleSetup(si)
         setup.setStartAndGoalStates(_state(si, problem.start), _state(si, problem.goal))
-        setup.setPlanner(getattr(og, OMPL_PLANNERS[planner_name])(si))
+        setup.setPlanner(_planner(si, planner_name, max_step))
         start = time.perf_counter()
         stop = _termination(ob, free, planning_time, max_checks)
         setup.solve(stop)
@@ -232,6 +238,17 @@ def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_ti
         og.PathSimplifier(si).simplifyMax(path)
         waypoints = np.array([_vector(state, problem.robot.n) for state in path.getStates()])
         return _OmplResult(waypoints, path_time, time.perf_counter() - start - path_time)
+
+
+def _planner(si: Any, planner_name: str, max_step: float | None) -> Any:
+    """The named OMPL planner on `si`; RRTConnect and RRT* extend at most `max_step` rad at a time (None: OMPL's
+    default step)."""
+    import ompl.geometric as og
+
+    planner = getattr(og, OMPL_PLANNERS[planner_name])(si)
+    if max_step is not None and hasattr(planner, "setRange"):
+        planner.setRange(max_step)
+    return planner
 
 
 def _no_path(planner_name: str, planning_time: float, free: FreeSpace) -> str:
@@ -363,7 +380,7 @@ def _import_backends() -> float:
 
 def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
                      resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
-                     max_checks: int | None = None) -> Plan:
+                     max_checks: int | None = None, max_step: float | None = MAX_STEP) -> Plan:
     """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (see the module docstring).
 
     `planner_name`: one of OMPL_PLANNERS. `planning_time` (s): OMPL's budget. RRTConnect stops at its first
@@ -372,7 +389,8 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     spacing of collision checks along straight joint-space segments. `grid_points`: TOPP-RA's path points.
     `margin` (m): clearance kept while planning, lowered to the start's or goal's clearance if that is smaller.
     `max_checks`: OMPL stops after checking this many configurations too (a budget that repeats on any machine;
-    planning_time may then be inf; only for the planners that plan in the calling thread, not PRM).
+    planning_time may then be inf; only for the planners that plan in the calling thread, not PRM). `max_step`
+    (rad): the longest extension of RRTConnect and RRT* (OMPL's `range`; BIT* and PRM have none); None: OMPL's.
 
     Status: "verified" or "violated" (dense `verify`), "no_path" (OMPL found no exact path in its budget) or
     "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start (`Plan.found`
@@ -385,7 +403,7 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
         return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
     setup = _import_backends()
     free = planning_space(problem, margin)
-    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks)
+    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
     extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
              "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,
              "margin_m": free.margin}
@@ -414,12 +432,13 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
 
 
 def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
-               resolution: float = 0.01, margin: float = 0.01, max_checks: int | None = None) -> np.ndarray | None:
+               resolution: float = 0.01, margin: float = 0.01, max_checks: int | None = None,
+               max_step: float | None = MAX_STEP) -> np.ndarray | None:
     """The baseline's simplified collision-free joint-space path (waypoints (k, n), rad) from start to goal, or None
     if the OMPL planner found none within `planning_time` s and `max_checks` configurations checked (options as for
     `plan_ompl_toppra`)."""
     free = planning_space(problem, margin)
-    return _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks).waypoints
+    return _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step).waypoints
 
 
 def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool = True,

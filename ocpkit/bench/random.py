@@ -7,8 +7,9 @@ position halfway along the straight joint-space path. With another range (lo, hi
 radius RADII, each near a different robot sphere of PATH_SPHERES at a random point of that path. Problems
 whose start or goal is invalid are redrawn, and so are problems whose obstacles leave no room to pass: a problem
 counts only once RRTConnect (seed PATH_SEED, at most PATH_CHECKS configurations checked, the planners' 0.01 m
-margin) has connected its start and goal. That certificate is a budget in collision checks, not seconds, so the
-same seed gives the same problems on any machine; the planners under test never see its path.
+margin, OMPL's own step: the one the published problem sets were drawn with) has connected its start and goal.
+That certificate is a budget in collision checks, not seconds, so the same seed gives the same problems on any
+machine; the planners under test never see its path.
 
 Prints one line per problem (with the hint of a plan that did not verify), then the status counts and the
 median and 90th-percentile computation time of the verified plans; with `out`, also results.csv, the trajectory
@@ -69,7 +70,8 @@ def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
             validate(problem)
         except ScenarioError:
             continue
-        if room_to_pass and joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS) is None:
+        if room_to_pass and joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS,
+                                       max_step=None) is None:
             continue
         count -= 1
         yield problem

@@ -12,8 +12,8 @@ from helpers import REPO, discretize
 
 import ocpkit
 import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
-from ocpkit.baselines.ompl_toppra import (FreeSpace, _space_information, _state, ompl_guess, plan_ompl_toppra,
-                                         planning_space)
+from ocpkit.baselines.ompl_toppra import (MAX_STEP, FreeSpace, _planner, _space_information, _state, ompl_guess,
+                                         plan_ompl_toppra, planning_space)
 from ocpkit.errors import OptionError, RegistryError, ScenarioError
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.verify import GEOMETRY_TOLERANCE
@@ -97,6 +97,17 @@ def test_a_budget_in_checks_stops_the_search_without_a_timer(case1):
     assert plan.stats.extra["validity_checks"] < 1000  # checked between OMPL's steps: at most one segment late
     with pytest.raises(OptionError, match="prm"):
         plan_ompl_toppra(case1, planner_name="prm", max_checks=50)
+
+
+def test_rrts_extend_at_most_max_step_and_a_step_that_is_not_positive_is_named(case1):
+    si = _space_information(case1, planning_space(case1, 0.01), 0.01)
+    assert _planner(si, "rrtconnect", 0.7).getRange() == 0.7
+    assert _planner(si, "rrtstar", MAX_STEP).getRange() == MAX_STEP
+    assert _planner(si, "rrtconnect", None).getRange() == 0.0  # OMPL's default, set when the planner is set up
+    assert not hasattr(_planner(si, "bitstar", 0.7), "getRange")  # BIT* has no step: made as it is
+    for step in (0.0, -1.0, np.inf, np.nan):
+        with pytest.raises(OptionError, match="max_step"):
+            plan_ompl_toppra(case1, max_step=step)
 
 
 @pytest.mark.slow
