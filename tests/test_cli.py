@@ -46,8 +46,8 @@ def test_list_gives_each_constraint_its_docstring_line(capsys):
     main(["list"])
     out = capsys.readouterr().out
     constraints = out.split("constraints\n")[1].split("solvers\n")[0].splitlines()
-    assert [line.split()[0] for line in constraints] == ["collision", "dynamics-consistency", "state-limits",
-                                                                "torque", "torque-rate"]
+    names = [line.split()[0] for line in constraints]
+    assert names == ["collision", "dynamics-consistency", "state-limits", "torque", "torque-rate"]
     assert all(len(line.split()) > 1 for line in constraints)  # a description follows every name
 
 
