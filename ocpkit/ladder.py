@@ -14,11 +14,14 @@ first rung is capped (MAX_ITERATIONS_CAPPED, per solve and for the rung's refine
 how the ladder leaves a local infeasibility, a restoration phase, a t_f pinned at its upper bound, or a motion that
 keeps tunnelling through a thin obstacle between check points round after round (MBM's cage) early. The OMPL +
 TOPP-RA motion (collision-free by construction) is the better start in clutter, and another seed gives another
-homotopy class when the first one is poor; its path search is budgeted in configurations checked (OMPL_CHECKS, the
-budget the random suite certifies room to pass with), so whether it finds a path does not depend on the machine's
-speed. More knots resolve what a coarse grid leaves violated. The continuation rung solves the problem relaxed
-first (a softened margin, wider limits) and the real one from there. The last rung is the uncapped single shot with
-whatever time is left, so the ladder never loses a plan the single shot finds in time.
+homotopy class when the first one is poor. The first two OMPL rungs solve on three pseudospectral segments of 6
+intervals (19 points instead of 12 knots' 13): piecewise polynomials follow a path with corners, where one
+polynomial of degree 12 leaves it between knots (figures: docs/design-notes.md). Their path search is budgeted in
+configurations checked (OMPL_CHECKS, the budget the random suite certifies room to pass with), so whether it
+finds a path does not depend on the machine's speed. More knots resolve what a coarse grid leaves violated. The
+continuation rung solves the problem relaxed first (a softened margin, wider limits) and the real one from there.
+The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
+shot finds in time.
 """
 
 from __future__ import annotations
@@ -36,7 +39,8 @@ OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path (a
 @dataclass(frozen=True)
 class Rung:
     """Option overrides of one attempt: `guess` ("line", "ompl" or None for the call's), OMPL `seed`, `knots`
-    and pseudospectral `segments` (None: the call's), `max_iterations` per solve (None: the solver's; no
+    (None: the call's), pseudospectral `segments` of `knots` intervals each (None: the call's; a transcription
+    without segments keeps the call's knots too), `max_iterations` per solve (None: the solver's; no
     refinement round starts once the rung's solves have used that many), and
     `relaxed`: a continuation, solving the problem relaxed (ocpkit.refine.RELAXED) first to warm-start the real
     one. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's time
@@ -53,8 +57,8 @@ class Rung:
 
 DEFAULT_LADDER: tuple[Rung, ...] = (
     Rung("first", max_iterations=MAX_ITERATIONS_CAPPED),
-    Rung("ompl-0", guess="ompl", seed=0, max_iterations=MAX_ITERATIONS_CAPPED),
-    Rung("ompl-1", guess="ompl", seed=1, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-0-segments-3", guess="ompl", seed=0, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-1-segments-3", guess="ompl", seed=1, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("relaxed-first", relaxed=True, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("first-uncapped"),

@@ -79,6 +79,8 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
         if rung.guess == "ompl":
             guess_options.update(max_checks=OMPL_CHECKS, planning_time=left)
         changed["guess_options"] = guess_options
+    if rung.segments is not None and not issubclass(TRANSCRIPTIONS.get(options["transcription"]), Pseudospectral):
+        rung = dataclasses.replace(rung, knots=None, segments=None)
     if rung.knots is not None:
         changed["knots"] = rung.knots
     if rung.segments is not None:
@@ -123,7 +125,8 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
             and time.perf_counter() < deadline and refined.iterations < budget \
-            and (wider := _widened(problem, options, made, near, refined.trajectory)):
+            and (wider := _widened(problem, _capped(options, budget - refined.iterations), made, near,
+                                   refined.trajectory)):
         (made, near), rebuilds = wider, rebuilds + 1
         refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, refined.result.w,
                                                     options["refinements"], deadline,
@@ -188,6 +191,15 @@ def _widened(problem: Problem, options: dict, made: Build, near: np.ndarray,
         return None
     near = np.vstack([near, samples])
     return _build(problem, options, near), near
+
+
+def _capped(options: dict, iterations: float) -> dict:
+    """`options` whose solves stop after `iterations` (the rest of a capped rung's budget; inf: unchanged), so a
+    rebuild's solve cannot take the rung past its budget."""
+    if not np.isfinite(iterations):
+        return options
+    cap = min(int(iterations), options["solver_options"].get("max_iterations", np.inf))
+    return {**options, "solver_options": {**options["solver_options"], "max_iterations": cap}}
 
 
 def _continued(before: Refined, after: Refined) -> Refined:

@@ -19,10 +19,7 @@ from ocpkit.errors import NoGuess
 from ocpkit.ladder import DEFAULT_LADDER, NO_PATH_HINT, OMPL_CHECKS, SINGLE_SHOT, Rung, climb, rank
 from ocpkit.plan import Plan, PlanStats
 from ocpkit.planner import GUESSES
-from ocpkit.simultaneous import (
-    _overridden,
-    plan_simultaneous,
-)
+from ocpkit.simultaneous import _capped, _overridden, plan_simultaneous
 from ocpkit.verify import Check, Verification
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -96,12 +93,12 @@ def test_an_empty_ladder_is_one_attempt_with_the_calls_options():
 
 
 def test_a_rung_overrides_only_what_it_names():
-    options = {"guess": "line", "guess_options": {"planning_time": 2.0}, "knots": 12,
+    options = {"guess": "line", "guess_options": {"planning_time": 2.0}, "knots": 12, "transcription": "chebyshev",
                "transcription_options": {"staged": False}, "solver_options": {"tol": 1e-7}}
     changed = _overridden(options, Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300), 9.0)
     assert changed == {"guess": "ompl", "guess_options": {"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
                                                           "planning_time": 9.0}, "knots": 16,
-                       "transcription_options": {"staged": False, "segments": 2},
+                       "transcription": "chebyshev", "transcription_options": {"staged": False, "segments": 2},
                        "solver_options": {"tol": 1e-7, "max_iterations": 300}, "iteration_budget": 300}
     assert options["knots"] == 12 and options["solver_options"] == {"tol": 1e-7}
     assert _overridden(options, Rung("same"), 9.0) == options and _overridden(options, None, 9.0) is options
@@ -109,6 +106,22 @@ def test_a_rung_overrides_only_what_it_names():
     assert line["guess_options"] == {"fallback": False}
     capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300), 9.0)
     assert capped["solver_options"] == {"max_iterations": 50} and "iteration_budget" not in capped
+
+
+def test_a_rebuild_solves_within_what_is_left_of_the_rungs_iteration_budget():
+    options = {"guess": "line", "solver_options": {"tol": 1e-7, "max_iterations": 300}}
+    assert _capped(options, 120.0)["solver_options"] == {"tol": 1e-7, "max_iterations": 120}
+    assert _capped(options, 500.0)["solver_options"]["max_iterations"] == 300
+    assert _capped({**options, "solver_options": {}}, 40.0)["solver_options"] == {"max_iterations": 40}
+    assert _capped(options, math.inf) is options and options["solver_options"]["max_iterations"] == 300
+
+
+def test_a_transcription_without_segments_keeps_the_calls_grid_on_a_rung_with_segments():
+    options = {"guess": "line", "guess_options": {}, "knots": 40, "transcription": "trapezoidal",
+               "transcription_options": {}}
+    changed = _overridden(options, Rung("x", guess="ompl", knots=6, segments=3), 9.0)
+    assert changed["knots"] == 40 and changed["transcription_options"] == {} and changed["guess"] == "ompl"
+    assert _overridden(options, Rung("y", knots=16), 9.0)["knots"] == 16
 
 
 def test_without_a_wall_time_limit_the_ladder_ends_by_its_budgets_in_work_and_repeats():

@@ -49,7 +49,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -68,6 +68,7 @@ REPAIR_ROUNDS = 8
 FRICTION_PASSES = 2
 TORQUE_RATE_WINDOW = 1e-3  # s
 MAX_STEP = 1.0  # rad: an RRT's longest extension (OMPL's `range`; module docstring, figures in README.md)
+GUESS_SLOWDOWN = 1.5  # the OMPL guess's motion takes this many times TOPP-RA's time (`ompl_guess`)
 SEGMENT_BATCH = 16  # configurations in the first batch checked along a segment; later batches double
 
 
@@ -337,6 +338,7 @@ class _TimedPath:
     motion: Any
     robot: Robot
     data: pin.Data
+    slowdown: float = 1.0  # the motion at t is toppra's at t / slowdown
 
     def __call__(self, t: np.ndarray) -> Samples:
         t = np.asarray(t, dtype=float)
@@ -347,8 +349,9 @@ class _TimedPath:
 
     def _state(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
         """q, qd, qdd, tau at times t (m,), each (m, n)."""
-        t = np.clip(t, *self.motion.path_interval)
-        q, qd, qdd = self.motion.eval(t), self.motion.evald(t), self.motion.evaldd(t)
+        c = self.slowdown
+        t = np.clip(t / c, *self.motion.path_interval)
+        q, qd, qdd = self.motion.eval(t), self.motion.evald(t) / c, self.motion.evaldd(t) / c**2
         return q, qd, qdd, rigid_torque(self.robot, q, qd, qdd, self.data) + self.robot.friction(qd)
 
 
@@ -442,15 +445,21 @@ def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time
 
 
 def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool = True,
-               **baseline_options: Any) -> np.ndarray:
-    """A warm start: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`) sampled on the
-    discretization's grid by `encode`. Without a baseline trajectory: the paper's straight line (the default) with
-    `fallback`, else NoGuess."""
+               slowdown: float = GUESS_SLOWDOWN, **baseline_options: Any) -> np.ndarray:
+    """A warm start: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`), slowed to
+    `slowdown` times its time, sampled on the discretization's grid by `encode`. Slowed, because TOPP-RA's
+    time-optimal timing rides the velocity and torque limits with bang-bang accelerations, leaving no room for the
+    torque-rate limits and the jerk cost the NLP must meet (figures: docs/design-notes.md). Without a baseline
+    trajectory: the paper's straight line (the default) with `fallback`, else NoGuess."""
+    if not slowdown >= 1.0:
+        raise OptionError(f"slowdown must be at least 1, got {slowdown!r}")
     baseline = plan_ompl_toppra(problem, **baseline_options)
-    if baseline.status not in ("no_path", "infeasible"):
-        return discretization.encode(baseline.trajectory)
-    if fallback:
-        return discretization.initial_guess(problem)
-    raise NoGuess(f"OMPL + TOPP-RA gave no trajectory ({baseline.status}: {baseline.stats.solver_message})")
-
-
+    if baseline.status in ("no_path", "infeasible"):
+        if fallback:
+            return discretization.initial_guess(problem)
+        raise NoGuess(f"OMPL + TOPP-RA gave no trajectory ({baseline.status}: {baseline.stats.solver_message})")
+    trajectory = baseline.trajectory
+    if isinstance(trajectory.interpolant, _TimedPath):
+        slowed = replace(trajectory.interpolant, slowdown=slowdown)
+        trajectory = Trajectory(slowed(slowdown * trajectory.knots.t), slowed)
+    return discretization.encode(trajectory)
