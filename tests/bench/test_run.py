@@ -255,7 +255,7 @@ def test_the_guess_and_seed_columns_follow_the_fallback_rung_that_gave_the_plan(
     from ocpkit.bench.task import _guess_and_seed
 
     assert _guess_and_seed("simultaneous", {}, None, "first") == ("paper", None)
-    assert _guess_and_seed("simultaneous", {}, None, "ompl-1") == ("ompl", 1)
+    assert _guess_and_seed("simultaneous", {}, None, "ompl-1-segments-3") == ("ompl", 1)
     assert _guess_and_seed("simultaneous", {"guess": "ompl", "fallbacks": ()}, 4, None) == ("ompl", 4)
     assert _guess_and_seed("ompl-toppra", {"seed": 2}, 2, None) == ("", 2)
 
