@@ -114,7 +114,7 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds \
                 or iterations >= iteration_budget or (lacking is not None and lacking(trajectory)):
             return Refined(result, trajectory, verification, iterations, taken, tuple(timing))
-        refinement, guess, taken = following, result.w, taken + 1
+        refinement, guess, taken = following, discretization.relifted(result.w, following), taken + 1
 
 
 def checked(result: SolverResult, layout: Layout, bounds: tuple[np.ndarray, np.ndarray]) -> SolverResult:

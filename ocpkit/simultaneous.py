@@ -19,6 +19,7 @@ from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
 from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
+from ocpkit.nlp import Refinement
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
 from ocpkit.problem import Problem
@@ -128,7 +129,8 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
             and (wider := _widened(problem, _capped(options, budget - refined.iterations), made, near,
                                    refined.trajectory)):
         (made, near), rebuilds = wider, rebuilds + 1
-        refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, refined.result.w,
+        restart = made.discretization.relifted(refined.result.w, Refinement())  # the checks back at their defaults
+        refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, restart,
                                                     options["refinements"], deadline,
                                                     iteration_budget=budget - refined.iterations,
                                                     lacking=_lacking(problem, made, near)))

@@ -149,3 +149,23 @@ def test_no_refinement_round_starts_once_the_motion_needs_rows_the_nlp_lacks(mon
     solver = Converges(10)
     refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), lacking=lacking)
     assert solver.calls == 2 and refined.rounds == 1 and not refined.verification.ok
+
+
+def test_a_round_starts_from_the_last_solution_relifted_at_its_own_check_slots(monkeypatch):
+    """A round that moves the adaptive checks starts with its lifting rows satisfied (Discretization.relifted),
+    not from w lifted where the checks were."""
+    moved = Refinement(np.array([0.37, 0.81]))
+    monkeypatch.setattr(sys.modules["ocpkit.refine"], "next_refinement", lambda *_: moved)
+    discretization = build(CASE2, knots=6).discretization
+    seen = []
+
+    class Records(Converges):
+        def solve(self, guess, parameters, bounds, max_wall_time=None):
+            seen.append(np.array(guess))
+            return super().solve(guess, parameters, bounds, max_wall_time)
+
+    w = discretization.initial_guess(CASE2)
+    solve_refined(discretization, Records(10), CASE2, w, rounds=1)
+    assert len(seen) == 2
+    np.testing.assert_allclose(seen[1], discretization.relifted(np.clip(w, *discretization.bounds(CASE2)), moved))
+    assert not np.allclose(seen[1], seen[0])

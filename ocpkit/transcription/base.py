@@ -99,6 +99,19 @@ class Discretization(ABC):
         planner's trajectory; for another OCP a trajectory of its chain (x, ẋ, ẍ in the Samples' q, qd, qdd)."""
 
     @abstractmethod
+    def write_checks(self, values: np.ndarray, trajectory: Trajectory, refinement: Refinement) -> None:
+        """Write `trajectory` sampled at the check times of `refinement` into the lifted check variables of w
+        `values` (n_w,), in place."""
+
+    def relifted(self, w: np.ndarray, refinement: Refinement) -> np.ndarray:
+        """w (n_w,) with its lifted check variables resampled from its own motion at the check times of
+        `refinement`: the warm start of a solve whose checks sit elsewhere than those w was solved with (a
+        refinement round, a rebuild), which would otherwise start with the lifting rows violated."""
+        values = np.array(w, dtype=float)
+        self.write_checks(values, self.decode(values), refinement)
+        return values
+
+    @abstractmethod
     def decode(self, w: np.ndarray) -> Trajectory:
         """The trajectory that the decision vector w represents."""
 

@@ -166,11 +166,15 @@ class MeshDiscretization(Discretization):
     def own_parameters(self, refinement: Refinement) -> dict[str, np.ndarray]:
         """Each of the refinement's check fractions (oldest first, so the newest wins) moves the check of its
         interval there, keeping CHECK_RANGE from the knots."""
+        return {"check_at": self._check_at(refinement)}
+
+    def _check_at(self, refinement: Refinement) -> np.ndarray:
+        """σ of each interval's check after `refinement` (N,), in fractions of its interval."""
         check_at = np.full(self.N, self.check_default)
         for fraction in refinement.check_fractions[::-1]:
             k = min(int(np.clip(fraction, 0, 1) * self.N), self.N - 1)
             check_at[k] = np.clip(fraction * self.N - k, *CHECK_RANGE)
-        return {"check_at": check_at}
+        return check_at
 
     def encode(self, trajectory: Trajectory) -> np.ndarray:
         """Sample `trajectory` at this NLP's knots, midpoints and default checks (scaled to its t_f); u is the
@@ -184,9 +188,13 @@ class MeshDiscretization(Discretization):
             w.write(values, "M", self.ocp.columns(at(intervals + 0.5)))
         if self.staged:
             w.write(values, "E", knots[1:])
-        w.write(values, "q_check", at(intervals + self.check_default).q)
+        self.write_checks(values, trajectory, Refinement())
         w.write(values, "tf", tf)
         return values
+
+    def write_checks(self, values: np.ndarray, trajectory: Trajectory, refinement: Refinement) -> None:
+        at = trajectory.tf * (np.arange(self.N) + self._check_at(refinement)) / self.N
+        self.nlp.variables.write(values, "q_check", trajectory.interpolant(at).q)
 
     def decode(self, w: np.ndarray) -> Trajectory:
         layout = self.nlp.variables

@@ -160,24 +160,31 @@ class PseudospectralDiscretization(Discretization):
     # -- numbers for one problem -------------------------------------------------------------------
     def own_parameters(self, refinement: Refinement) -> dict[str, np.ndarray]:
         """The refinement's first check fractions move the adaptive slots (the rest stay at their defaults)."""
+        rows, drows = self.grid.matrices(self._adaptive_sigma(refinement))
+        return {"adaptive_rows": rows, "adaptive_drows": drows}
+
+    def _adaptive_sigma(self, refinement: Refinement) -> np.ndarray:
+        """σ of the adaptive check slots after `refinement` (slots, )."""
         sigma = self.adaptive_default.copy()
         chosen = 2.0 * np.clip(refinement.check_fractions[: len(sigma)], 0, 1) - 1.0
         sigma[: len(chosen)] = chosen
-        rows, drows = self.grid.matrices(sigma)
-        return {"adaptive_rows": rows, "adaptive_drows": drows}
+        return sigma
 
     def encode(self, trajectory: Trajectory) -> np.ndarray:
         """Sample `trajectory` at this NLP's knots and check times (scaled to its t_f); u is the rigid-body
         torque rnea(q, qd, qdd) / tau_max of the sampled motion."""
         tf, w = trajectory.tf, self.nlp.variables
-        at = lambda sigma: trajectory.interpolant(tf * (sigma + 1.0) / 2.0)  # noqa: E731
-        knots, checks = at(self.grid.knots), at(np.concatenate([self.check_sigma, self.adaptive_default]))
         values = np.zeros(w.size)
-        w.write(values, "X", self.ocp.columns(knots))
-        for part in CHECK_PARTS:
-            w.write(values, f"{part}_check", getattr(checks, part).T)
+        w.write(values, "X", self.ocp.columns(trajectory.interpolant(tf * (self.grid.knots + 1.0) / 2.0)))
+        self.write_checks(values, trajectory, Refinement())
         w.write(values, "tf", tf)
         return values
+
+    def write_checks(self, values: np.ndarray, trajectory: Trajectory, refinement: Refinement) -> None:
+        sigma = np.concatenate([self.check_sigma, self._adaptive_sigma(refinement)])
+        checks = trajectory.interpolant(trajectory.tf * (sigma + 1.0) / 2.0)
+        for part in CHECK_PARTS:
+            self.nlp.variables.write(values, f"{part}_check", getattr(checks, part).T)
 
     def decode(self, w: np.ndarray) -> Trajectory:
         layout = self.nlp.variables

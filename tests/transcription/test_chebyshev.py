@@ -125,6 +125,20 @@ def test_check_fractions_move_the_adaptive_slots(disc):
     np.testing.assert_allclose(p.read(moved, "adaptive_rows")[0], np.eye(KNOTS + 1)[KNOTS // 2], atol=1e-14)
 
 
+def test_relifted_moves_the_lifted_checks_with_the_slots_and_nothing_else(disc):
+    nlp, layout = disc.nlp, disc.nlp.variables
+    w = disc.encode(quintic(PROBLEM, 2.0))
+    moved = Refinement(np.array([0.37, 0.81]))
+    _, g = evaluate(disc, w, PROBLEM, moved)
+    assert np.abs(g[nlp.lbg == nlp.ubg]).max() > 1e-3  # lifted where the slots were, not where they are
+    relifted = disc.relifted(w, moved)
+    _, g = evaluate(disc, relifted, PROBLEM, moved)
+    assert np.abs(g[nlp.lbg == nlp.ubg]).max() < 1e-8
+    lifted = np.concatenate([layout.index(f"{part}_check").ravel() for part in ("q", "qd", "qdd")])
+    np.testing.assert_array_equal(np.delete(relifted, lifted), np.delete(w, lifted))
+    np.testing.assert_allclose(disc.relifted(w, Refinement()), w, atol=1e-12)  # the default slots: as encoded
+
+
 def test_extra_margin_tightens_the_clearance_rows(disc):
     nlp = disc.nlp
     w = disc.encode(quintic(PROBLEM, 2.0))

@@ -60,10 +60,13 @@ def test_moved_checks_keep_the_equalities_exact(method):
     assert np.count_nonzero(check_at != 0.5) == 3
     _, g = evaluate(disc, w, PROBLEM, moved)
     assert np.abs(g[nlp.lbg == nlp.ubg]).max() > 1e-5  # the checks encoded at σ = ½ are off the moved ones
+    relifted = disc.relifted(w, moved)  # encode sampled the checks at their default σ; lift them to the moved ones
     checks = layout.index("q_check")  # (N, n)
-    for k in range(N):  # encode samples the checks at their default σ; lift them to the moved ones
-        w[checks[k]] = disc.decode(w).interpolant(np.array([TF * (k + check_at[k]) / N])).q[0]
-    _, g = evaluate(disc, w, PROBLEM, moved)
+    for k in range(N):  # by hand: the motion at each moved check
+        np.testing.assert_allclose(relifted[checks[k]],
+                                   disc.decode(w).interpolant(np.array([TF * (k + check_at[k]) / N])).q[0], atol=1e-12)
+    np.testing.assert_array_equal(np.delete(relifted, checks), np.delete(w, checks))  # nothing else changes
+    _, g = evaluate(disc, relifted, PROBLEM, moved)
     assert np.abs(g[nlp.lbg == nlp.ubg]).max() < 1e-9
 
 
