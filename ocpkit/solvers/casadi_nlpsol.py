@@ -211,7 +211,7 @@ class Ipopt(CasadiNlpsol):
     the KKT system by approximate minimum fill (mumps_pivot_order 2, where MUMPS's automatic choice takes PORD),
     both faster on our KKT systems. The barrier parameter stays below mu_max = 10⁻³ (IPOPT's default 10⁵): the
     adaptive strategy otherwise falls back to a monotone barrier of ~0.1 on a slow iterate, which pushes a start
-    near a solution far from it (t_f up towards its bound, then slowly back) (figures: docs/design-notes.md)."""
+    near a solution far from it: t_f up towards its bound, then slowly back (figures: docs/design-notes.md)."""
 
     name = plugin = "ipopt"
     statuses = {

@@ -164,7 +164,7 @@ class PseudospectralDiscretization(Discretization):
         return {"adaptive_rows": rows, "adaptive_drows": drows}
 
     def _adaptive_sigma(self, refinement: Refinement) -> np.ndarray:
-        """σ of the adaptive check slots after `refinement` (slots, )."""
+        """σ of the adaptive check slots after `refinement` (slots,)."""
         sigma = self.adaptive_default.copy()
         chosen = 2.0 * np.clip(refinement.check_fractions[: len(sigma)], 0, 1) - 1.0
         sigma[: len(chosen)] = chosen
