@@ -2,15 +2,15 @@
 
 A 7-joint arm of 60 spheres among a dozen boxes has about 1100 collision terms per point (MotionBenchMaker's
 Panda: 690 sphere pairs of its own and 400 sphere-obstacle terms within reach), most of them far from contact on
-any motion the solver will consider; IPOPT's linear solves grow with every row. So when the constraints have more
-than SCREEN_ABOVE terms per point, the planner builds the NLP with the terms whose clearance is below
-SCREEN_DISTANCE somewhere along the straight line and along the initial guess (`Constraint.screened`), solves,
-and — verification always checks every term densely — keeps a verified plan as it is. An unverified plan whose
-motion comes within MISSING_DISTANCE of a term left out is solved again, warm-started, with the terms near it
-added (a rebuild, part of the computation time), at most MAX_REBUILDS times; such a motion also ends the
-refinement rounds at once (ocpkit.refine), since rounds on an NLP without those rows cannot fix it (before, a
-capped rung spent its iterations on them and ended `violated`, the rows still missing). Below SCREEN_ABOVE (the
-paper's robot: 75 terms) the NLP keeps every term within reach, as before.
+any motion the solver will consider; IPOPT's linear solves grow with every row. So the planner builds the NLP
+with the terms whose clearance is below SCREEN_DISTANCE somewhere along the straight line and along the initial
+guess (`Constraint.screened`), solves, and — verification always checks every term densely — keeps a verified plan
+as it is. An unverified plan whose motion comes within MISSING_DISTANCE of a term left out is solved again,
+warm-started, with the terms near it added (a rebuild, part of the computation time), at most MAX_REBUILDS times;
+such a motion also ends the refinement rounds at once (ocpkit.refine), since rounds on an NLP without those rows
+cannot fix it (before, a capped rung spent its iterations on them and ended `violated`, the rows still missing).
+Every robot and scene with collision terms screens, the paper's robot (75 terms per point) too: its paper cases keep
+few of them, and IPOPT's linear solves shrink with the rows (figures: docs/design-notes.md).
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ from ocpkit.constraints import Constraint
 from ocpkit.problem import Problem
 from ocpkit.trajectory import Trajectory
 
-SCREEN_ABOVE = 200  # collision terms per point above which the planner screens them
 SCREEN_DISTANCE = 0.2  # m: a term is kept when its clearance is below this somewhere near the motion
 MISSING_DISTANCE = 0.1  # m: a left-out term this close to an unverified plan's motion triggers a rebuild
 MAX_REBUILDS = 3
@@ -36,8 +35,8 @@ def screenable_rows(constraints: Sequence[Constraint]) -> int:
 
 
 def worth_screening(constraints: Sequence[Constraint]) -> bool:
-    """Whether the constraints have more than SCREEN_ABOVE screenable terms per point."""
-    return screenable_rows(constraints) > SCREEN_ABOVE
+    """Whether the constraints have any screenable terms (collision terms) at all."""
+    return screenable_rows(constraints) > 0
 
 
 def line_samples(problem: Problem) -> np.ndarray:

@@ -18,6 +18,7 @@ from ocpkit.build_cache import Build, build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
+from ocpkit.geometry import clearances, sphere_centers_batch
 from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.nlp import Refinement
 from ocpkit.plan import Plan, finish
@@ -28,6 +29,8 @@ from ocpkit.solvers import SolverStatus
 from ocpkit.trajectory import Trajectory
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.pseudospectral import Pseudospectral
+
+END_CHECK_CLEARANCE = 0.05  # m: a start or goal this close to contact gets checks in every knot interval
 
 
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
@@ -53,8 +56,8 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     be interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when it
     runs out. `fallbacks` is the ladder of rungs (ocpkit.ladder), each overriding these options, tried in order
     until one plan verifies; () plans once with these options (SINGLE_SHOT, the paper's setting). `screen`: whether
-    the NLP carries only the collision rows near the motion (ocpkit.screening; None: when the robot and scene have
-    more than screening.SCREEN_ABOVE collision terms per point)."""
+    the NLP carries only the collision rows near the motion (ocpkit.screening; None: whenever the robot and scene have
+    collision terms)."""
     options = {"transcription": transcription, "knots": knots, "dynamics": dynamics, "solver": solver,
                "guess": guess, "refinements": refinements, "constraints": constraints,
                "transcription_options": transcription_options or {}, "solver_options": solver_options or {},
@@ -102,8 +105,7 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
     rebuild with them added."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
-    if near is not None:
-        options = _checked_near_the_ends(options)
+    options = _checked_near_the_ends(problem, options)
     made = _build(problem, options, near)
     deadline = time.perf_counter() + max_wall_time
     dynamics = options["dynamics"]
@@ -147,18 +149,23 @@ def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
 
 def _screening_start(problem: Problem, options: dict) -> np.ndarray | None:
     """The configurations the first build screens the collision rows by (the straight line), or None when the
-    plan does not screen (`screen` False, or None and too few rows to pay: ocpkit.screening)."""
+    plan does not screen (`screen` False, or None and no collision terms to screen: ocpkit.screening)."""
     screen = options["screen"]
     if screen is None:
         screen = screening.worth_screening(make_constraints(problem, options["constraints"]))
     return screening.line_samples(problem) if screen else None
 
 
-def _checked_near_the_ends(options: dict) -> dict:
-    """`options` with `end_checks` for a pseudospectral transcription (unless given): a problem worth screening is
-    a cluttered one, whose start and goal sit close to obstacles (ocpkit.transcription.pseudospectral)."""
+def _checked_near_the_ends(problem: Problem, options: dict) -> dict:
+    """`options` with `end_checks` for a pseudospectral transcription (unless given) when the start or the goal is
+    within END_CHECK_CLEARANCE of contact: the arm still moves fast in the short knot intervals near an end, and can
+    dip between two knots into whatever it starts or stops beside (ocpkit.transcription.pseudospectral)."""
     transcription = TRANSCRIPTIONS.get(options["transcription"])
     if not issubclass(transcription, Pseudospectral) or "end_checks" in options["transcription_options"]:
+        return options
+    ends = np.stack([problem.start, problem.goal])
+    if clearances(problem.robot, problem.scene, sphere_centers_batch(problem.robot, ends)).smallest() \
+            >= END_CHECK_CLEARANCE:
         return options
     return {**options, "transcription_options": {**options["transcription_options"], "end_checks": True}}
 

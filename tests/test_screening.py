@@ -10,7 +10,7 @@ from ocpkit.constraints.collision import SphereCollision
 from ocpkit.geometry import clearances, sphere_centers_batch
 from ocpkit.scenario import load_scenario
 from ocpkit.screening import line_samples, worth_screening
-from ocpkit.simultaneous import _checked_near_the_ends, plan_simultaneous
+from ocpkit.simultaneous import END_CHECK_CLEARANCE, _checked_near_the_ends, plan_simultaneous
 from ocpkit.transcription.pseudospectral import long_interval_midpoints
 from tests.helpers import REPO
 
@@ -42,9 +42,10 @@ def test_missing_counts_the_left_out_terms_near_other_configurations():
     assert kept.missing(PANDA, elsewhere, 0.1) >= close.sum() > 0
 
 
-def test_only_constraints_with_many_terms_are_worth_screening():
+def test_constraints_with_any_collision_terms_are_worth_screening():
     assert worth_screening(make_constraints(PANDA))
-    assert not worth_screening(make_constraints(PAPER))  # the paper's robot keeps every row, as before
+    assert worth_screening(make_constraints(PAPER))  # the paper's robot screens too
+    assert not worth_screening(make_constraints(PAPER, ("state-limits", "torque", "torque-rate")))
 
 
 def test_other_constraints_are_not_screened():
@@ -68,9 +69,16 @@ def test_every_knot_interval_is_checked_when_asked():
     assert np.all((every[:-1] - points[1:-1]) * (every[1:] - points[1:-1]) < 0)  # one between each pair of knots
 
 
-def test_a_screened_plan_checks_near_the_ends_unless_told_otherwise():
-    assert _checked_near_the_ends(PLAN_OPTIONS)["transcription_options"] == {"end_checks": True}
+def test_a_plan_checks_near_the_ends_when_an_end_is_close_to_contact_unless_told_otherwise():
+    ends = np.stack([PANDA.start, PANDA.goal])
+    assert clearances(PANDA.robot, PANDA.scene, sphere_centers_batch(PANDA.robot, ends)).smallest() \
+        < END_CHECK_CLEARANCE  # MBM's goal on the table
+    assert _checked_near_the_ends(PANDA, PLAN_OPTIONS)["transcription_options"] == {"end_checks": True}
+    ends = np.stack([PAPER.start, PAPER.goal])
+    assert clearances(PAPER.robot, PAPER.scene, sphere_centers_batch(PAPER.robot, ends)).smallest() \
+        >= END_CHECK_CLEARANCE
+    assert _checked_near_the_ends(PAPER, PLAN_OPTIONS) is PLAN_OPTIONS  # the paper's ends are clear of everything
     told = {**PLAN_OPTIONS, "transcription_options": {"end_checks": False}}
-    assert _checked_near_the_ends(told) is told
+    assert _checked_near_the_ends(PANDA, told) is told
     mesh = {**PLAN_OPTIONS, "transcription": "trapezoidal"}
-    assert _checked_near_the_ends(mesh) is mesh  # a mesh transcription has no such option
+    assert _checked_near_the_ends(PANDA, mesh) is mesh  # a mesh transcription has no such option
