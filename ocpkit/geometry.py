@@ -82,9 +82,10 @@ def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:
     """Clearances of sphere centres (K, M, 3) against each other, the obstacles and the workspace box."""
     r = robot.sphere_radius
     a, b = robot.self_collision.T if len(robot.self_collision) else (np.zeros(0, int), np.zeros(0, int))
-    self_pairs = np.linalg.norm(centers[:, a] - centers[:, b], axis=-1) - (r[a] + r[b])
-    gaps = centers[:, :, None, :] - scene.obstacle_centers[None, None]
-    distances = [np.linalg.norm(gaps, axis=-1) - scene.obstacle_radii[None, :]]
+    gaps = centers[:, a] - centers[:, b]
+    self_pairs = np.sqrt(np.einsum("kpi,kpi->kp", gaps, gaps)) - (r[a] + r[b])
+    offsets = centers[:, :, None, :] - scene.obstacle_centers[None, None]
+    distances = [np.sqrt(np.einsum("kmsi,kmsi->kms", offsets, offsets)) - scene.obstacle_radii[None, :]]
     shapes = ((box_distance, scene.boxes), (cylinder_distance, scene.cylinders))
     distances += [distance(centers, group) for distance, group in shapes if len(group)]  # skipped when empty: the
     obstacles = np.concatenate(distances, axis=-1) - r[:, None]  # OMPL validity checker calls this thousands of times
