@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ocpkit.geometry import Clearances, clearances, sphere_centers_batch
 from ocpkit.robots import Robot
 from ocpkit.scene import Scene
 
@@ -36,6 +37,10 @@ class Problem:
     def jerk_weights(self) -> np.ndarray:
         """Diagonal of Q, shape (n,): 1 / R_ii²."""
         return 1.0 / self.robot.gear_ratios**2
+
+    def end_clearances(self) -> Clearances:
+        """The robot's clearances (m) at the start and the goal: each kind with a leading axis of 2."""
+        return clearances(self.robot, self.scene, sphere_centers_batch(self.robot, np.stack([self.start, self.goal])))
 
     def velocity_lower_bound(self) -> float:
         """max_i |goal_i - start_i| / qd_max_i, seconds: no plan can be faster than this."""

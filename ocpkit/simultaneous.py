@@ -18,7 +18,6 @@ from ocpkit.build_cache import Build, build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
-from ocpkit.geometry import clearances, sphere_centers_batch
 from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
 from ocpkit.nlp import Refinement
 from ocpkit.plan import Plan, finish
@@ -163,9 +162,7 @@ def _checked_near_the_ends(problem: Problem, options: dict) -> dict:
     transcription = TRANSCRIPTIONS.get(options["transcription"])
     if not issubclass(transcription, Pseudospectral) or "end_checks" in options["transcription_options"]:
         return options
-    ends = np.stack([problem.start, problem.goal])
-    if clearances(problem.robot, problem.scene, sphere_centers_batch(problem.robot, ends)).smallest() \
-            >= END_CHECK_CLEARANCE:
+    if problem.end_clearances().smallest() >= END_CHECK_CLEARANCE:
         return options
     return {**options, "transcription_options": {**options["transcription_options"], "end_checks": True}}
 

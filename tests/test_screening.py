@@ -69,16 +69,10 @@ def test_every_knot_interval_is_checked_when_asked():
     assert np.all((every[:-1] - points[1:-1]) * (every[1:] - points[1:-1]) < 0)  # one between each pair of knots
 
 
-def _ends_clearance(problem) -> float:
-    """The smallest clearance (m) at the start and the goal."""
-    ends = np.stack([problem.start, problem.goal])
-    return clearances(problem.robot, problem.scene, sphere_centers_batch(problem.robot, ends)).smallest()
-
-
 def test_a_plan_checks_near_the_ends_when_an_end_is_close_to_contact_unless_told_otherwise():
-    assert _ends_clearance(PANDA) < END_CHECK_CLEARANCE  # MBM's goal on the table
+    assert PANDA.end_clearances().smallest() < END_CHECK_CLEARANCE  # MBM's goal on the table
     assert _checked_near_the_ends(PANDA, PLAN_OPTIONS)["transcription_options"] == {"end_checks": True}
-    assert _ends_clearance(PAPER) >= END_CHECK_CLEARANCE
+    assert PAPER.end_clearances().smallest() >= END_CHECK_CLEARANCE
     assert _checked_near_the_ends(PAPER, PLAN_OPTIONS) is PLAN_OPTIONS  # the paper's ends are clear of everything
     told = {**PLAN_OPTIONS, "transcription_options": {"end_checks": False}}
     assert _checked_near_the_ends(PANDA, told) is told
