@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= results/paper
 
-.PHONY: demo test clean chromium
+.PHONY: demo test clean chromium compiler
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -14,10 +14,10 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet --config-settings editable_mode=compat -e ".[test]"
 	touch $@
 
-demo: $(VENV)/.installed
+demo: $(VENV)/.installed compiler
 	$(BIN)/ocpkit bench paper --out $(OUT)
 
-test: $(VENV)/.installed chromium
+test: $(VENV)/.installed chromium compiler
 	$(BIN)/python -m pytest -q
 
 # The report and viewer tests take screenshots with headless Chromium (Debian's package; installed as root).
@@ -25,6 +25,13 @@ chromium:
 	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || { [ "$$(id -u)" = 0 ] && \
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; } || \
 		{ echo "install chromium (apt-get install chromium) for the report and viewer tests"; exit 1; }
+
+# The dynamics derivatives are compiled to C once per robot (ocpkit.solvers.compiled): a C compiler (Debian's gcc,
+# installed as root); without one the planner runs them uncompiled, the same values, slower.
+compiler:
+	@command -v "$${CC:-cc}" >/dev/null || { [ "$$(id -u)" = 0 ] && apt-get update -qq && \
+		DEBIAN_FRONTEND=noninteractive apt-get install -y -qq gcc; } || \
+		echo "no C compiler: the dynamics derivatives run uncompiled (slower); apt-get install gcc"
 
 clean:
 	rm -rf $(VENV) results

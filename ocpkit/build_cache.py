@@ -23,6 +23,7 @@ from ocpkit.errors import OptionError
 from ocpkit.problem import Problem
 from ocpkit.screening import SCREEN_DISTANCE
 from ocpkit.solvers import SOLVERS, PreparedSolver
+from ocpkit.solvers.compiled import compile_seconds
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
 
@@ -32,7 +33,8 @@ CACHE_SIZE = 8  # builds; one of a 7-joint MBM problem holds 350–450 MB
 @dataclass(frozen=True)
 class Build:
     """A Discretization, a solver prepared for its NLP, the seconds its set-up took (0 when it came from the
-    cache) and their split: `setup_parts` {"graph": the transcription's build, "solver": the solver's prepare}
+    cache) and their split: `setup_parts` {"graph": the transcription's build, "solver": the solver's prepare,
+    "compile": the part of it spent compiling C (ocpkit.solvers.compiled; 0 when the disk cache had it)}
     (s, empty when cached)."""
 
     discretization: Discretization
@@ -64,10 +66,11 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
         return Build(_BUILDS[key].discretization, _BUILDS[key].solver, 0.0)
     began = time.perf_counter()
     discretization = method.build(problem, backend, plugins, ocp)
-    built = time.perf_counter()
+    built, compiling = time.perf_counter(), compile_seconds()
     prepared = nlp_solver.prepare(discretization.nlp)
-    ended = time.perf_counter()
-    _BUILDS[key] = Build(discretization, prepared, ended - began, {"graph": built - began, "solver": ended - built})
+    ended, compiled = time.perf_counter(), compile_seconds() - compiling
+    _BUILDS[key] = Build(discretization, prepared, ended - began,
+                         {"graph": built - began, "solver": ended - built - compiled, "compile": compiled})
     while len(_BUILDS) > CACHE_SIZE:
         _BUILDS.popitem(last=False)
     return _BUILDS[key]

@@ -8,6 +8,7 @@ minus radius. This module is the single numeric reference used by scenario check
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,29 +38,55 @@ AXES = {"X": 0, "Y": 1, "Z": 2}
 """The joint axis of pinocchio's aligned 1-DoF joints (JointModelRX ... JointModelPZ), by the name's last letter."""
 
 
+@dataclass(frozen=True)
+class _Joint:
+    """One 1-DoF joint of a robot's model as `sphere_centers_batch` composes it: its parent joint, its q index,
+    its placement in the parent (rotation (3, 3), translation (3,)); revolute: the cross-product matrix [a]x of
+    its axis and [a]x² (Rodrigues), prismatic: the axis in the parent's frame."""
+
+    parent: int
+    index: int
+    rotation: np.ndarray
+    translation: np.ndarray
+    revolute: bool
+    cross: np.ndarray
+    cross_squared: np.ndarray
+    slide: np.ndarray
+
+
+@functools.lru_cache(maxsize=32)
+def _joints(robot: Robot) -> tuple[_Joint, ...]:
+    """The joints 1, 2, ... of `robot`'s model (robots hash by identity)."""
+    out = []
+    for j in range(1, robot.model.njoints):
+        joint, placement = robot.model.joints[j], robot.model.jointPlacements[j]
+        kind = joint.shortname()
+        axis = joint.extract().axis if kind.endswith("Unaligned") else np.eye(3)[AXES[kind[-1]]]
+        cross = np.cross(np.eye(3), axis)
+        out.append(_Joint(robot.model.parents[j], joint.idx_q, placement.rotation.copy(),
+                          placement.translation.copy(), kind.startswith("JointModelR"), cross, cross @ cross,
+                          placement.rotation @ axis))
+    return tuple(out)
+
+
 def sphere_centers_batch(robot: Robot, qs: np.ndarray) -> np.ndarray:
     """`sphere_centers` of many configurations qs (K, n) at once, shape (K, M, 3): the joint poses composed in
     numpy over all K together (revolute and prismatic 1-DoF joints, the ones ocpkit models), instead of one
     pinocchio forward-kinematics call per configuration; the same numbers (tests/test_geometry.py)."""
-    model, qs = robot.model, np.atleast_2d(np.asarray(qs, dtype=float))
-    rotation = np.empty((model.njoints, len(qs), 3, 3))
-    translation = np.empty((model.njoints, len(qs), 3))
+    qs = np.atleast_2d(np.asarray(qs, dtype=float))
+    rotation = np.empty((robot.model.njoints, len(qs), 3, 3))
+    translation = np.empty((robot.model.njoints, len(qs), 3))
     rotation[0], translation[0] = np.eye(3), 0.0
-    for j in range(1, model.njoints):
-        joint, placement, parent = model.joints[j], model.jointPlacements[j], model.parents[j]
-        kind = joint.shortname()
-        axis = joint.extract().axis if kind.endswith("Unaligned") else np.eye(3)[AXES[kind[-1]]]
-        q = qs[:, joint.idx_q]
-        local_r = np.broadcast_to(placement.rotation, (len(qs), 3, 3))
-        local_t = np.broadcast_to(placement.translation, (len(qs), 3))
-        if kind.startswith("JointModelR"):  # Rodrigues: R(q) = I + sin q [a]x + (1 − cos q) [a]x²
-            cross = np.cross(np.eye(3), axis)
-            turn = np.eye(3) + np.sin(q)[:, None, None] * cross + (1 - np.cos(q))[:, None, None] * (cross @ cross)
-            local_r = local_r @ turn
+    for j, joint in enumerate(_joints(robot), start=1):
+        q = qs[:, joint.index]
+        if joint.revolute:  # Rodrigues: R(q) = I + sin q [a]x + (1 − cos q) [a]x²
+            turn = np.sin(q)[:, None, None] * joint.cross + (1 - np.cos(q))[:, None, None] * joint.cross_squared
+            rotation[j] = rotation[joint.parent] @ (joint.rotation + joint.rotation @ turn)
+            local_t = joint.translation
         else:
-            local_t = local_t + np.einsum("ij,j->i", placement.rotation, axis) * q[:, None]
-        rotation[j] = rotation[parent] @ local_r
-        translation[j] = translation[parent] + np.einsum("kij,kj->ki", rotation[parent], local_t)
+            rotation[j] = rotation[joint.parent] @ joint.rotation
+            local_t = joint.translation + joint.slide * q[:, None]
+        translation[j] = translation[joint.parent] + (rotation[joint.parent] @ local_t[..., None])[..., 0]
     r, t = rotation[robot.sphere_joint], translation[robot.sphere_joint]  # (M, K, 3, 3), (M, K, 3)
     return (np.einsum("mkij,mj->kmi", r, robot.sphere_offset) + t.transpose(1, 0, 2))
 

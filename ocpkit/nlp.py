@@ -90,6 +90,9 @@ class PointCall:
     inputs: tuple[ca.SX, ...]
     parameters: tuple[ca.SX, ...]
     first_row: int
+    compiled: bool = False
+    """Whether its derivatives are worth compiling to C: set for a function that depends on the robot and the OCP
+    only (the dynamics rows), whose C is then the same for every problem of the robot (ocpkit.solvers.compiled)."""
 
 
 @dataclass(frozen=True)

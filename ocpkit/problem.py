@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,8 +39,9 @@ class Problem:
         """Diagonal of Q, shape (n,): 1 / R_ii²."""
         return 1.0 / self.robot.gear_ratios**2
 
+    @functools.cached_property
     def end_clearances(self) -> Clearances:
-        """The robot's clearances (m) at the start and the goal: each kind with a leading axis of 2."""
+        """The robot's clearances (m) at the start and the goal: each kind with a leading axis of 2 (computed once)."""
         return clearances(self.robot, self.scene, sphere_centers_batch(self.robot, np.stack([self.start, self.goal])))
 
     def velocity_lower_bound(self) -> float:

@@ -162,7 +162,7 @@ def _checked_near_the_ends(problem: Problem, options: dict) -> dict:
     transcription = TRANSCRIPTIONS.get(options["transcription"])
     if not issubclass(transcription, Pseudospectral) or "end_checks" in options["transcription_options"]:
         return options
-    if problem.end_clearances().smallest() >= END_CHECK_CLEARANCE:
+    if problem.end_clearances.smallest() >= END_CHECK_CLEARANCE:
         return options
     return {**options, "transcription_options": {**options["transcription_options"], "end_checks": True}}
 

@@ -70,9 +70,9 @@ def test_every_knot_interval_is_checked_when_asked():
 
 
 def test_a_plan_checks_near_the_ends_when_an_end_is_close_to_contact_unless_told_otherwise():
-    assert PANDA.end_clearances().smallest() < END_CHECK_CLEARANCE  # MBM's goal on the table
+    assert PANDA.end_clearances.smallest() < END_CHECK_CLEARANCE  # MBM's goal on the table
     assert _checked_near_the_ends(PANDA, PLAN_OPTIONS)["transcription_options"] == {"end_checks": True}
-    assert PAPER.end_clearances().smallest() >= END_CHECK_CLEARANCE
+    assert PAPER.end_clearances.smallest() >= END_CHECK_CLEARANCE
     assert _checked_near_the_ends(PAPER, PLAN_OPTIONS) is PLAN_OPTIONS  # the paper's ends are clear of everything
     told = {**PLAN_OPTIONS, "transcription_options": {"end_checks": False}}
     assert _checked_near_the_ends(PANDA, told) is told

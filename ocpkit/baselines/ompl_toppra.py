@@ -124,7 +124,7 @@ def planning_space(problem: Problem, margin: float) -> FreeSpace:
     """The FreeSpace OMPL plans in: `margin` (m), lowered to half the start's or goal's clearance if that is
     smaller, as the transcriptions lower theirs (a margin as wide as an end's clearance would leave no room to
     leave it)."""
-    return FreeSpace(problem, min(margin, 0.5 * problem.end_clearances().smallest()))
+    return FreeSpace(problem, min(margin, 0.5 * problem.end_clearances.smallest()))
 
 
 # -- OMPL ---------------------------------------------------------------------------------------------

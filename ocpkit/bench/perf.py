@@ -6,19 +6,24 @@ solver's own work (IPOPT's call minus those callbacks), split into linear solves
 by the shares IPOPT's own timing statistics give on one extra plan per case (`ipopt_shares`), the iteration
 callback (Python), the solver call's wrapper,
 verification, the guess and the rest of Python; and by solve (the first, each refinement round). The one-time
-set-up split into graph construction (the transcription's build) and solver creation (nlpsol: CasADi generates
-and sparsity-analyses its derivative functions there; nothing is compiled to C, so compilation is 0). Medians and
+set-up split into graph construction (the transcription's build), solver creation (nlpsol: CasADi generates and
+sparsity-analyses its derivative functions there) and compilation (the dynamics rows' point derivatives, compiled
+to C once per robot and machine and kept on disk: ocpkit.solvers.compiled; the fresh builds of a run find them
+there after the first, so a cold compile is measured once on its own, in an empty directory). Medians and
 95th percentiles over the repeats of all cases, ratios to the paper's figures; growth of computation and set-up
 with knots, obstacle spheres and robot joints, as growth.png with a fitted power law.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
+import os
 import re
 import statistics
 import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -175,8 +180,28 @@ def summary_table(splits: dict[str, dict[int, list[Sample]]]) -> str:
     for guess, split in splits.items():
         lines += [f"{guess:<7}" + _summary_row(n, samples) for n, samples in split.items()]
     lines.append("line: the timed line guess (ocpkit.guesses); paper: the paper's (straight line over t_f = 10 s); "
-                 "compile: nothing is compiled to C")
+                 "compile: C compiled in the set-up, 0 when the disk cache had it")
     return "\n".join(lines)
+
+
+def cold_compile(problem: Problem, knots: int) -> dict:
+    """The set-up parts (s) of a fresh build of `problem` at `knots` with an empty disk cache of compiled C."""
+    with tempfile.TemporaryDirectory() as folder, _environment("OCPKIT_COMPILED_DIR", folder):
+        return planned(problem, knots, fresh=True).setup_parts
+
+
+@contextlib.contextmanager
+def _environment(name: str, value: str) -> Iterator[None]:
+    """The environment variable `name` set to `value` for the duration."""
+    before = os.environ.get(name)
+    os.environ[name] = value
+    try:
+        yield
+    finally:
+        if before is None:
+            del os.environ[name]
+        else:
+            os.environ[name] = before
 
 
 def _summary_row(n: int, samples: list[Sample]) -> str:
@@ -189,7 +214,8 @@ def _summary_row(n: int, samples: list[Sample]) -> str:
             f"{sum(s.status == 'verified' for s in samples):>6}/{len(samples):<3}"
             f"{statistics.median(s.setup for s in setups):>8.2f}s"
             f"{statistics.median(s.setup_parts.get('graph', 0) for s in setups):>7.2f}s"
-            f"{statistics.median(s.setup_parts.get('solver', 0) for s in setups):>7.2f}s{0:>8.2f}s"
+            f"{statistics.median(s.setup_parts.get('solver', 0) for s in setups):>7.2f}s"
+            f"{statistics.median(s.setup_parts.get('compile', 0) for s in setups):>8.2f}s"
             f"{PAPER_SETUP:>6.1f}s")
 
 
@@ -311,12 +337,12 @@ def write_split_csv(path: Path, split: dict[int, list[Sample]]) -> None:
     with path.open("w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow(["knots", "status", "iterations", "computation", *PARTS, "solves", "setup", "graph",
-                         "solver"])
+                         "solver", "compile"])
         for n, samples in split.items():
             for s in samples:
                 writer.writerow([n, s.status, s.iterations, s.computation, *(s.parts[p] for p in PARTS),
                                  " ".join(f"{t:.6f}" for t in s.solves), s.setup, s.setup_parts.get("graph", ""),
-                                 s.setup_parts.get("solver", "")])
+                                 s.setup_parts.get("solver", ""), s.setup_parts.get("compile", "")])
 
 
 def run_perf(scenarios: Path, out: Path, repeats: int = 5, quick: bool = False) -> dict[int, list[Sample]]:
@@ -327,6 +353,9 @@ def run_perf(scenarios: Path, out: Path, repeats: int = 5, quick: bool = False) 
     split = paper_split(problems, repeats)
     print(split_table(split), flush=True)
     print(summary_table({"line": split, "paper": paper_split(problems, repeats, guess="paper")}), flush=True)
+    cold = cold_compile(problems[0], KNOTS[0])
+    print(f"a cold compile ({problems[0].name}, {KNOTS[0]} knots, empty disk cache): set-up "
+          f"{sum(cold.values()):.2f} s, of which compile {cold.get('compile', 0):.2f} s", flush=True)
     write_split_csv(out / "split.csv", split)
     case = next((p for p in problems if p.name == GROWTH_CASE), problems[0])
     rows = growth(case, 1 if quick else 3, GROWTH_KNOTS[:2] if quick else GROWTH_KNOTS,

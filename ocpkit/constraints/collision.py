@@ -85,7 +85,7 @@ class SphereCollision(Constraint):
     def margin_caps(self, problem: Problem) -> np.ndarray:
         """Per row, in `evaluate`'s order: half the row's clearance (m) at the start or the goal, whichever is smaller
         (≥ 0): the largest margin it can take while its own ends keep it."""
-        ends = problem.end_clearances()
+        ends = problem.end_clearances
         m, axis = self._face_rows()
         faces = np.minimum(np.where(self.face_mask[m, axis], ends.workspace[:, m, axis], np.inf),
                            np.where(self.face_mask[m, axis + 3], ends.workspace[:, m, axis + 3], np.inf))

@@ -205,7 +205,8 @@ class CasadiNlpsol(Solver):
 class Ipopt(CasadiNlpsol):
     """IPOPT with exact Hessian by CasADi AD (L-BFGS when the NLP has none) and the MUMPS linear solver; the
     constraint Jacobian and the Hessian are built point by point where the NLP has point calls
-    (ocpkit.solvers.pointwise: the same values, a fraction of the set-up);
+    (ocpkit.solvers.pointwise: the same values, a fraction of the set-up), the dynamics rows' through point
+    derivatives compiled to C once per robot and machine unless `compiled` is False (ocpkit.solvers.compiled);
     extra keyword options go to IPOPT verbatim (e.g. tol=1e-8). MUMPS starts without threshold pivoting
     (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out inaccurate) and orders
     the KKT system by approximate minimum fill (mumps_pivot_order 2, where MUMPS's automatic choice takes PORD),
@@ -224,14 +225,16 @@ class Ipopt(CasadiNlpsol):
     }
     stops_by_callback = True  # the wall-time limit, per call (module docstring)
 
-    def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, **ipopt_options) -> None:
+    def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, compiled: bool = True,
+                 **ipopt_options) -> None:
         super().__init__(max_iterations, max_wall_time)
+        self.compiled = compiled
         self.options = {"linear_solver": "mumps", "print_level": 0, "sb": "yes", "tol": 1e-6,
                         "mu_strategy": "adaptive", "mumps_pivtol": 0.0, "mumps_pivot_order": 2,
                         "mu_max": 1e-3, "max_iter": max_iterations, **ipopt_options}
 
     def plugin_options(self, nlp: NLP) -> dict:
-        derivatives = pointwise_derivatives(nlp) if nlp.point_calls and nlp.exact_hessian else {}
+        derivatives = pointwise_derivatives(nlp, self.compiled) if nlp.point_calls and nlp.exact_hessian else {}
         return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}, **derivatives}
 
 

@@ -14,14 +14,23 @@ The last term appears only where Z is not linear in x (a torque with friction, a
 shared by several calls (the values at one point) are differentiated once. The other rows (collocation and
 interpolation defects, nearly linear) are differentiated by CasADi a few rows at a time, and the objective too
 when it is not a point call. The result equals CasADi's own derivatives (tests/solvers/test_pointwise.py).
+
+Calls marked `compiled` (the dynamics rows: their point function depends on the robot and the OCP only, so its C
+is the same for every problem of a robot) are differentiated by point functions compiled to C
+(ocpkit.solvers.compiled), evaluated over all their points by one mapped call, and joined by constant sparse
+matrices: blocks B_k placed as Σ_k L_kᵀ B_k R_k (L_k, R_k: row selections or A_k), whose nonzeros are P times
+the blocks' stacked nonzeros, vec(Lᵀ B R) = (Rᵀ ⊗ Lᵀ) vec(B). This needs A_k constant (inputs linear in x), and
+falls back to the SX graph where it is not or where nothing compiles.
 """
 
 from __future__ import annotations
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sps
 
 from ocpkit.nlp import NLP, PointCall
+from ocpkit.solvers.compiled import compiled
 
 ROWS_AT_ONCE = 6
 """The other rows are differentiated this many consecutive rows at a time: rows added together read the same few
@@ -29,17 +38,33 @@ knots, so each chunk needs few sweeps over a small graph, where all rows at once
 them (figures: docs/design-notes.md)."""
 
 
-def pointwise_derivatives(nlp: NLP) -> dict[str, ca.Function]:
+def pointwise_derivatives(nlp: NLP, compile: bool = True) -> dict[str, ca.Function]:
     """IPOPT's {"jac_g": (x, p) → (g, ∂g/∂x), "hess_lag": (x, p, λ_f, λ_g) → upper triangle of
-    ∇²ₓ(λ_f f + λ_gᵀ g)} for `nlp` (SX, with point calls), built as the module docstring says."""
+    ∇²ₓ(λ_f f + λ_gᵀ g)} for `nlp` (SX, with point calls), built as the module docstring says; `compile`: the
+    calls marked `compiled` through compiled point functions."""
+    marked = [c for c in nlp.point_calls if c.compiled] if compile else []
+    terms = _compiled_terms(nlp, marked) if marked else None
+    if terms is None:
+        return _graph_derivatives(nlp, list(nlp.point_calls), np.zeros(0, dtype=int))
+    kept = [c for c in nlp.point_calls if not c.compiled]
+    return _joined(nlp, _graph_derivatives(nlp, kept, np.concatenate([_rows(c) for c in marked])), terms)
+
+
+def _rows(call: PointCall) -> np.ndarray:
+    """The rows of g that `call` gives."""
+    return np.arange(call.first_row, call.first_row + call.function.numel_out(0))
+
+
+def _graph_derivatives(nlp: NLP, point_calls: list[PointCall], left: np.ndarray) -> dict[str, ca.Function]:
+    """The derivatives as SX graphs, of g's rows less `left` (rows another term gives: zero here)."""
     x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
     lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g.numel())
-    rows = [np.arange(c.first_row, c.first_row + c.function.numel_out(0)) for c in nlp.point_calls]
-    calls = [*zip(nlp.point_calls, (lam_g[r.tolist()] for r in rows))]
+    rows = [_rows(c) for c in point_calls]
+    calls = [*zip(point_calls, (lam_g[r.tolist()] for r in rows))]
     if nlp.objective_call is not None:
         calls.append((nlp.objective_call, lam_f))
     A, jacobians, hessians = _chain(calls, x)
-    called = np.concatenate(rows) if rows else np.zeros(0, dtype=int)
+    called = np.concatenate([*rows, left]).astype(int)
     others = np.setdiff1d(np.arange(g.numel()), called).tolist()
     rest = g[others]
     objective = 0 if nlp.objective_call is not None else lam_f * f
@@ -50,10 +75,92 @@ def pointwise_derivatives(nlp: NLP) -> dict[str, ca.Function]:
     point_rows = ca.mtimes(ca.diagcat(*constraint_jacobians), A[:sum(j.size2() for j in constraint_jacobians), :])
     starts = range(0, len(others), ROWS_AT_ONCE)
     other_rows = [ca.jacobian(rest[i:min(i + ROWS_AT_ONCE, len(others))], x) for i in starts]
-    jac = ca.vertcat(point_rows, *other_rows)[np.argsort(np.concatenate([called, others])).tolist(), :]
+    jac = ca.vertcat(point_rows, ca.SX(len(left), x.numel()), *other_rows)
+    jac = jac[np.argsort(np.concatenate([called, others])).tolist(), :]
     return {"jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac], ["x", "p"], ["g", "jac_g_x"]),
             "hess_lag": ca.Function("nlp_hess_l", [x, p, lam_f, lam_g], [ca.triu(hess)],
                                     ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])}
+
+
+def _joined(nlp: NLP, graphs: dict[str, ca.Function],
+            terms: tuple[ca.Function, ca.Function]) -> dict[str, ca.Function]:
+    """IPOPT's derivatives (as `pointwise_derivatives`) as MX Functions: the SX `graphs` plus the compiled `terms`."""
+    x, p = ca.MX.sym("x", nlp.x.numel()), ca.MX.sym("p", nlp.p.numel())
+    lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", nlp.g.numel())
+    g, jac = graphs["jac_g"](x, p)
+    hess = graphs["hess_lag"](x, p, lam_f, lam_g) + terms[1](x, p, lam_g)
+    return {"jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac + terms[0](x, p)], ["x", "p"], ["g", "jac_g_x"]),
+            "hess_lag": ca.Function("nlp_hess_l", [x, p, lam_f, lam_g], [hess],
+                                    ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])}
+
+
+def _compiled_terms(nlp: NLP, marked: list[PointCall]) -> tuple[ca.Function, ca.Function] | None:
+    """MX Functions (x, p → the `marked` calls' rows of ∂g/∂x; x, p, λ_g → their part of the Hessian's upper
+    triangle) through compiled point derivatives (module docstring); None when an input of theirs is not linear
+    in x or nothing compiles."""
+    x, p, n_x, n_g = nlp.x, nlp.p, nlp.x.numel(), nlp.g.numel()
+    groups: dict[int, list[PointCall]] = {}
+    for call in marked:
+        groups.setdefault(id(call.function), []).append(call)
+    A = [ca.jacobian(ca.vertcat(*(ca.vec(v) for v in c.inputs)), x) for calls in groups.values() for c in calls]
+    if any(ca.depends_on(a, ca.vertcat(x, p)) for a in A):
+        return None
+    derivatives = [(_nonzeros(jacobian, f"jac_{i}"), _nonzeros(hessian, f"hess_{i}")) for i, (jacobian, hessian) in
+                   enumerate(_point_derivatives(c[0].function, len(c[0].inputs)) for c in groups.values())]
+    loaded = compiled([function for pair in derivatives for function, _ in pair])
+    if loaded is None:
+        return None
+    X, P, lam_g = ca.MX.sym("x", n_x), ca.MX.sym("p", nlp.p.numel()), ca.MX.sym("lam_g", n_g)
+    jacobians, hessians, jacobian_places, hessian_places = [], [], [], []
+    placements = iter(ca.evalf(a).sparse() for a in A)
+    for calls, ((_, jacobian_sparsity), (_, hessian_sparsity)), jacobian, hessian in zip(
+            groups.values(), derivatives, loaded[0::2], loaded[1::2]):
+        arguments = _mapped_arguments(calls, x, p)(X, P)
+        weights = ca.reshape(lam_g[np.concatenate([_rows(c) for c in calls]).tolist()], -1, len(calls))
+        jacobians.append(ca.vec(jacobian.map(len(calls))(*arguments)))
+        hessians.append(ca.vec(hessian.map(len(calls))(*arguments, weights)))
+        for call, a in zip(calls, placements):
+            rows = _rows(call)
+            selection = sps.csr_matrix((np.ones(len(rows)), (np.arange(len(rows)), rows)), shape=(len(rows), n_g))
+            jacobian_places.append((jacobian_sparsity, selection, a))
+            hessian_places.append((hessian_sparsity, a, a))
+    return (ca.Function("compiled_jacobian", [X, P], [_placed(jacobian_places, ca.vertcat(*jacobians), n_g, n_x)]),
+            ca.Function("compiled_hessian", [X, P, lam_g],
+                        [_placed(hessian_places, ca.vertcat(*hessians), n_x, n_x, upper=True)]))
+
+
+def _nonzeros(function: ca.Function, name: str) -> tuple[ca.Function, ca.Sparsity]:
+    """(`function` renamed `name` with its one output as the column of its nonzeros, that output's sparsity)."""
+    symbols = function.sx_in()
+    out = function(*symbols)
+    return ca.Function(name, symbols, [out.nz[:]]), out.sparsity()
+
+
+def _mapped_arguments(calls: list[PointCall], x: ca.SX, p: ca.SX) -> ca.Function:
+    """x, p → the inputs and parameters of `calls` (one point function's) side by side, as its map takes them."""
+    function = calls[0].function
+    columns = [ca.vertcat(*(ca.vec(v) for v in (*c.inputs, *c.parameters))) for c in calls]
+    sizes = [function.numel_in(i) for i in range(function.n_in())]
+    stacked = ca.vertsplit(ca.horzcat(*columns), np.concatenate([[0], np.cumsum(sizes)]).astype(int).tolist())
+    return ca.Function("mapped_arguments", [x, p], [ca.reshape(s, function.size1_in(i), function.size2_in(i) *
+                                                                len(calls)) for i, s in enumerate(stacked)])
+
+
+def _placed(places: list[tuple[ca.Sparsity, sps.spmatrix, sps.spmatrix]], nonzeros: ca.MX, rows: int, columns: int,
+            upper: bool = False) -> ca.MX:
+    """Σ_k L_kᵀ B_k R_k (rows × columns, its upper triangle if `upper`) for places (sparsity of B_k, L_k, R_k), the
+    B_k's nonzeros stacked in `nonzeros`: P · nonzeros on the sum's sparsity (module docstring)."""
+    parts = []
+    for sparsity, left, right in places:
+        linear = np.asarray(sparsity.get_col()) * sparsity.size1() + np.asarray(sparsity.row())
+        parts.append(sps.kron(right.T, left.T, format="csc")[:, linear])
+    full = sps.hstack(parts, format="csr")
+    reached = np.flatnonzero(np.diff(full.indptr))
+    row, column = reached % rows, reached // rows
+    if upper:
+        reached, row, column = reached[row <= column], row[row <= column], column[row <= column]
+    sparsity = ca.Sparsity.triplet(rows, columns, row.tolist(), column.tolist())
+    return ca.MX(sparsity, ca.mtimes(ca.DM(full[reached].tocsc()), nonzeros))
 
 
 def _chain(calls: list[tuple[PointCall, ca.SX]], x: ca.SX) -> tuple[ca.SX, list[ca.SX], list[ca.SX]]:

@@ -108,7 +108,7 @@ class Assembly:
             node = Node(*_symbols_like(x))
             self._defect = ca.Function("defect", [*node, *self._ocp_parameters],
                                        [self.ocp.defect(self.dynamics, node)])
-        self._call(self._defect, tuple(x), self._ocp_parameters, 0.0, 0.0)
+        self._call(self._defect, tuple(x), self._ocp_parameters, 0.0, 0.0, compiled=True)
 
     def jerk_s(self, x: Node, dxdd_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
         """The robot's jerk times dt/ds (n, 1) at a point where the chain's ẍ has slope dẍ/ds = `dxdd_ds`."""
@@ -161,9 +161,9 @@ class Assembly:
         self._call(function, _point_fields(values), _context_symbols(self.contexts[index]), lower, upper)
 
     def _call(self, function: ca.Function, inputs: tuple, parameters: tuple, lower: np.ndarray | float,
-              upper: np.ndarray | float) -> None:
-        """The rows lower ≤ function(*inputs, *parameters) ≤ upper, recorded as a point call."""
-        self.point_calls.append(PointCall(function, inputs, parameters, self.row_count))
+              upper: np.ndarray | float, compiled: bool = False) -> None:
+        """The rows lower ≤ function(*inputs, *parameters) ≤ upper, recorded as a point call (see PointCall)."""
+        self.point_calls.append(PointCall(function, inputs, parameters, self.row_count, compiled))
         self.add(Rows(function(*inputs, *parameters), lower, upper))
 
     # -- the result ----------------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 """IPOPT's derivatives built point by point (ocpkit.solvers.pointwise) against CasADi's own Jacobian and Hessian of
 the same NLP, at random points, for every transcription family, a scene with spheres, a box and a cylinder, the
-path-timing OCP (whose point inputs are not linear in w) and a robot with friction."""
+path-timing OCP (whose point inputs are not linear in w) and a robot with friction; with the dynamics rows' point
+derivatives compiled to C (ocpkit.solvers.compiled) and without, and without a C compiler."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import numpy as np
 import pytest
 from helpers import REPO
 
+import ocpkit.solvers.compiled as compiled_module
 from ocpkit import load_scenario
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
@@ -32,14 +34,14 @@ def _path_timing() -> PathTimingOCP:
     return PathTimingOCP(CASE.robot, PathSpline.fit(lengths, waypoints))
 
 
-def _assert_same_derivatives(discretization, problem) -> None:
+def _assert_same_derivatives(discretization, problem, compile: bool = True) -> dict[str, ca.Function]:
     nlp = discretization.nlp
     assert nlp.point_calls and nlp.exact_hessian
     x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
     lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g.numel())
     reference = ca.Function("reference", [x, p, lam_f, lam_g], [
         ca.jacobian(g, x), ca.triu(ca.hessian(lam_f * f + ca.dot(lam_g, g), x)[0])])
-    ours = pointwise_derivatives(nlp)
+    ours = pointwise_derivatives(nlp, compile)
     rng = np.random.default_rng(0)
     w0, params = discretization.initial_guess(problem), discretization.parameters(problem)
     for _ in range(3):
@@ -51,15 +53,42 @@ def _assert_same_derivatives(discretization, problem) -> None:
         np.testing.assert_allclose(ca.densify(jac).full(), jac_expected, rtol=1e-9, atol=1e-9)
         hess = ca.densify(ours["hess_lag"](w, params, *lam)).full()
         np.testing.assert_allclose(hess, hess_expected, rtol=1e-9, atol=1e-9 * np.abs(hess_expected).max())
+    return ours
 
 
+def _discretization(transcription: str, options: dict):
+    dynamics = make_dynamics("casadi-rnea", PROBLEM.robot)
+    return TRANSCRIPTIONS.get(transcription)(**options).build(PROBLEM, dynamics, make_constraints(PROBLEM))
+
+
+@pytest.mark.parametrize("compile", [
+    pytest.param(True, marks=pytest.mark.skipif(compiled_module.compiler() is None, reason="no C compiler")), False])
 @pytest.mark.parametrize("transcription, options", [
     ("chebyshev", {"knots": 8}), ("lgl", {"knots": 5, "segments": 2}), ("lgr", {"knots": 6}),
     ("hermite-simpson", {"knots": 6}), ("trapezoidal", {"knots": 8})])
-def test_pointwise_derivatives_equal_casadis_own(transcription, options):
-    dynamics = make_dynamics("casadi-rnea", PROBLEM.robot)
-    discretization = TRANSCRIPTIONS.get(transcription)(**options).build(PROBLEM, dynamics, make_constraints(PROBLEM))
-    _assert_same_derivatives(discretization, PROBLEM)
+def test_pointwise_derivatives_equal_casadis_own(transcription, options, compile):
+    ours = _assert_same_derivatives(_discretization(transcription, options), PROBLEM, compile)
+    assert ours["hess_lag"].is_a("MXFunction") == compile  # compiled terms join the graphs in an MX Function
+
+
+@pytest.mark.skipif(compiled_module.compiler() is None, reason="no C compiler (make test installs gcc as root)")
+def test_compiled_libraries_are_kept_and_reused(tmp_path, monkeypatch):
+    monkeypatch.setenv("OCPKIT_COMPILED_DIR", str(tmp_path))
+    _assert_same_derivatives(_discretization("chebyshev", {"knots": 6}), PROBLEM)
+    libraries = sorted(tmp_path.glob("*.so"))
+    assert len(libraries) == 1
+    stamp = libraries[0].stat().st_mtime_ns
+    _assert_same_derivatives(_discretization("chebyshev", {"knots": 9}), PROBLEM)  # other knots, the same C
+    assert sorted(tmp_path.glob("*.so")) == libraries and libraries[0].stat().st_mtime_ns == stamp
+
+
+def test_without_a_compiler_the_graphs_are_used_with_a_warning(tmp_path, monkeypatch):
+    monkeypatch.setenv("OCPKIT_COMPILED_DIR", str(tmp_path))
+    monkeypatch.setenv("CC", "no-such-compiler-here")
+    monkeypatch.setattr(compiled_module, "_warned", set())
+    with pytest.warns(UserWarning, match="no C compiler"):
+        ours = _assert_same_derivatives(_discretization("chebyshev", {"knots": 6}), PROBLEM)
+    assert not ours["hess_lag"].is_a("MXFunction") and not list(tmp_path.iterdir())
 
 
 def test_pointwise_derivatives_with_inputs_not_linear_in_w():
