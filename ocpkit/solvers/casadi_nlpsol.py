@@ -73,11 +73,13 @@ DIVERGED = 1.0
 
 class _Deadline(ca.Callback):
     """nlpsol iteration callback that asks the solver to stop once the deadline (time.perf_counter s) has
-    passed or the iterate has left its bounds; `reason` ("deadline", "bounds" or "") says which."""
+    passed or (when it `watches_bounds`) the iterate has left its bounds; `reason` ("deadline", "bounds" or "")
+    says which."""
 
-    def __init__(self, n_w: int, n_g: int, n_p: int) -> None:
+    def __init__(self, n_w: int, n_g: int, n_p: int, watches_bounds: bool = True) -> None:
         ca.Callback.__init__(self)
         self.sizes = {"x": n_w, "lam_x": n_w, "g": n_g, "lam_g": n_g, "lam_p": n_p, "f": 1}
+        self.watches_bounds = watches_bounds
         self.arm(np.inf, np.full(n_w, -np.inf), np.full(n_w, np.inf))
         self.construct("deadline", {})
 
@@ -105,8 +107,8 @@ class _Deadline(ca.Callback):
 
     def eval(self, arg: list) -> list:
         try:
-            x = np.asarray(arg[0]).ravel()
-            if not np.all((x >= self.lower) & (x <= self.upper)):
+            if self.watches_bounds and not np.all((self.lower <= (x := np.asarray(arg[0]).ravel())) &
+                                                  (x <= self.upper)):
                 self.reason = "bounds"
             elif time.perf_counter() > self.deadline:
                 self.reason = "deadline"
@@ -163,6 +165,8 @@ class CasadiNlpsol(Solver):
     """The plugin's `return_status` → our status; statuses not listed go by CasADi's unified status."""
     stops_by_callback = False
     """Whether the plugin honours nlpsol's `iteration_callback` (then used for the time limit)."""
+    stays_in_bounds = False
+    """Whether every iterate keeps within its variable bounds (then the callback does not check them)."""
 
     def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0) -> None:
         self.max_iterations, self.max_wall_time = max_iterations, max_wall_time
@@ -174,7 +178,8 @@ class CasadiNlpsol(Solver):
     def prepare(self, nlp: NLP) -> PreparedNlpsol:
         problem = {"x": nlp.x, "p": nlp.p, "f": nlp.f, "g": nlp.g}
         options = {"print_time": False, "record_time": True, "error_on_fail": False, **self.plugin_options(nlp)}
-        deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel()) if self.stops_by_callback else None
+        deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel(), not self.stays_in_bounds) \
+            if self.stops_by_callback else None
         if deadline is not None:
             options["iteration_callback"] = deadline
         try:
@@ -224,6 +229,7 @@ class Ipopt(CasadiNlpsol):
         "Maximum_CpuTime_Exceeded": SolverStatus.TIME_LIMIT,
     }
     stops_by_callback = True  # the wall-time limit, per call (module docstring)
+    stays_in_bounds = True  # an interior point
 
     def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, compiled: bool = True,
                  **ipopt_options) -> None:
