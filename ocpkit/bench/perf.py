@@ -16,16 +16,15 @@ with knots, obstacle spheres and robot joints, as growth.png with a fitted power
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import dataclasses
 import os
 import re
 import statistics
 import tempfile
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 from tqdm import tqdm
@@ -186,22 +185,8 @@ def summary_table(splits: dict[str, dict[int, list[Sample]]]) -> str:
 
 def cold_compile(problem: Problem, knots: int) -> dict:
     """The set-up parts (s) of a fresh build of `problem` at `knots` with an empty disk cache of compiled C."""
-    with tempfile.TemporaryDirectory() as folder, _environment("OCPKIT_COMPILED_DIR", folder):
+    with tempfile.TemporaryDirectory() as folder, mock.patch.dict(os.environ, {"OCPKIT_COMPILED_DIR": folder}):
         return planned(problem, knots, fresh=True).setup_parts
-
-
-@contextlib.contextmanager
-def _environment(name: str, value: str) -> Iterator[None]:
-    """The environment variable `name` set to `value` for the duration."""
-    before = os.environ.get(name)
-    os.environ[name] = value
-    try:
-        yield
-    finally:
-        if before is None:
-            del os.environ[name]
-        else:
-            os.environ[name] = before
 
 
 def _summary_row(n: int, samples: list[Sample]) -> str:

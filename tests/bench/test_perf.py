@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from helpers import REPO
 
-from ocpkit.bench.perf import (EVALUATIONS, PARTS, cluttered, fitted_exponent, ipopt_timing, linear_share, planned,
-                               run_perf)
+from ocpkit.bench.perf import (EVALUATIONS, PARTS, cluttered, cold_compile, fitted_exponent, ipopt_timing,
+                               linear_share, planned, run_perf)
+from ocpkit.solvers.compiled import compiler
 from ocpkit.geometry import clearances, sphere_centers
 from ocpkit.scenario import load_scenario
 
@@ -30,6 +33,16 @@ def test_split_adds_up_to_the_wall_time():
     # every measured part is a real interval inside the plan: the unaccounted Python rest is small and not negative
     assert -1e-3 <= s.parts["python"] <= 0.2 * s.computation + 0.01
     assert sum(s.solves) <= s.computation + 1e-6
+
+
+@pytest.mark.skipif(compiler() is None, reason="no C compiler (make test installs gcc as root)")
+def test_a_cold_compile_is_measured_apart_and_a_warm_build_compiles_nothing(monkeypatch):
+    monkeypatch.delenv("OCPKIT_COMPILED_DIR", raising=False)
+    cold = cold_compile(CASE2, 6)
+    assert cold["compile"] > 0 and "OCPKIT_COMPILED_DIR" not in os.environ
+    planned(CASE2, 6, fresh=True)  # the machine's own cache: compiles on a fresh machine
+    warm = planned(CASE2, 6, fresh=True)
+    assert warm.status == "verified" and warm.setup_parts["compile"] == 0 and warm.setup_parts["solver"] > 0
 
 
 def test_cluttered_adds_spheres_clear_of_the_straight_line():
