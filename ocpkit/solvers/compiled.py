@@ -5,7 +5,7 @@
 (~/.cache/ocpkit/compiled, or $XDG_CACHE_HOME/ocpkit/compiled; $OCPKIT_COMPILED_DIR overrides), and loads it
 with casadi.external: the same values as CasADi's virtual machine, several times faster. A library is written
 under a temporary name and renamed into place, so processes compiling the same C at once do not clash.
-Without a compiler, or when a compile fails, there is nothing to load: None, with one warning.
+Without a compiler, or when a compile or the loading fails, there is nothing to load: None, with one warning.
 """
 
 from __future__ import annotations
@@ -63,7 +63,11 @@ def compiled(functions: Sequence[ca.Function]) -> list[ca.Function] | None:
         except (OSError, subprocess.CalledProcessError) as exc:
             detail = exc.stderr.decode(errors="replace").strip()[-300:] if getattr(exc, "stderr", None) else exc
             return _unavailable(f"compiling to {library} failed: {detail}")
-    return [ca.external(function.name(), str(library)) for function in functions]
+    try:
+        return [ca.external(function.name(), str(library)) for function in functions]
+    except RuntimeError as exc:  # e.g. a library damaged on disk
+        return _unavailable(f"cannot load {library} (delete it to compile afresh): "
+                            f"{str(exc).strip().splitlines()[-1]}")
 
 
 def _compile(cc: str, source: str, library: Path) -> None:

@@ -82,6 +82,18 @@ def test_compiled_libraries_are_kept_and_reused(tmp_path, monkeypatch):
     assert sorted(tmp_path.glob("*.so")) == libraries and libraries[0].stat().st_mtime_ns == stamp
 
 
+@pytest.mark.skipif(compiled_module.compiler() is None, reason="no C compiler (make test installs gcc as root)")
+def test_a_damaged_library_falls_back_to_the_graphs_with_a_warning(tmp_path, monkeypatch):
+    monkeypatch.setenv("OCPKIT_COMPILED_DIR", str(tmp_path))
+    monkeypatch.setattr(compiled_module, "_warned", set())
+    _assert_same_derivatives(_discretization("chebyshev", {"knots": 6}), PROBLEM)
+    for library in tmp_path.glob("*.so"):
+        library.write_bytes(b"not a shared library")
+    with pytest.warns(UserWarning, match="cannot load"):
+        ours = _assert_same_derivatives(_discretization("chebyshev", {"knots": 6}), PROBLEM)
+    assert not ours["hess_lag"].is_a("MXFunction")
+
+
 def test_without_a_compiler_the_graphs_are_used_with_a_warning(tmp_path, monkeypatch):
     monkeypatch.setenv("OCPKIT_COMPILED_DIR", str(tmp_path))
     monkeypatch.setenv("CC", "no-such-compiler-here")
