@@ -105,10 +105,13 @@ class _Deadline(ca.Callback):
     def get_sparsity_in(self, i: int) -> ca.Sparsity:
         return ca.Sparsity.dense(self.sizes[ca.nlpsol_out(i)], 1)
 
+    def _outside(self, x: np.ndarray) -> bool:
+        """Whether the iterate x (n_w,) has left [lower, upper]."""
+        return not np.all((x >= self.lower) & (x <= self.upper))
+
     def eval(self, arg: list) -> list:
         try:
-            if self.watches_bounds and not np.all((self.lower <= (x := np.asarray(arg[0]).ravel())) &
-                                                  (x <= self.upper)):
+            if self.watches_bounds and self._outside(np.asarray(arg[0]).ravel()):
                 self.reason = "bounds"
             elif time.perf_counter() > self.deadline:
                 self.reason = "deadline"

@@ -25,12 +25,12 @@ import casadi as ca
 FLAGS = ("-O1", "-fPIC", "-shared")
 """-O1: ~4.5× CasADi's virtual machine on the dynamics derivatives; -O2 and -O3 compile longer for little more."""
 _warned: set[str] = set()
-_spent = [0.0]  # seconds this process has spent compiling
+_spent = 0.0  # seconds this process has spent compiling
 
 
 def compile_seconds() -> float:
     """Seconds this process has spent compiling so far (the set-up's `compile` part: ocpkit.build_cache)."""
-    return _spent[0]
+    return _spent
 
 
 def cache_directory() -> Path:
@@ -72,6 +72,7 @@ def compiled(functions: Sequence[ca.Function]) -> list[ca.Function] | None:
 
 def _compile(cc: str, source: str, library: Path) -> None:
     """Compile `source` into `library`, written under a temporary name and renamed into place."""
+    global _spent
     began = time.perf_counter()
     library.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=library.parent) as work:
@@ -79,7 +80,7 @@ def _compile(cc: str, source: str, library: Path) -> None:
         c_file.write_text(source)
         subprocess.run([cc, *FLAGS, str(c_file), "-o", str(built)], check=True, capture_output=True)
         os.replace(built, library)
-    _spent[0] += time.perf_counter() - began
+    _spent += time.perf_counter() - began
 
 
 def _unavailable(reason: str) -> None:
