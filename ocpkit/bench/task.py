@@ -2,7 +2,10 @@
 
 A task is plain data (a dict: the scenario mapping, case, scene, method, repeat, suite), so a local worker
 process or a Dask worker on another machine can run it; each process keeps its own build cache
-(ocpkit.build_cache), so later tasks of a shape it has built skip the set-up. The outcome is plain data too:
+(ocpkit.build_cache) while it plans one scenario, so its later methods and repeats of a shape it has built skip
+the set-up, and clears it when the scenario changes: builds held from earlier problems (about 400 MB each for a
+7-joint MBM problem, several per plan with the ladder's rungs and screening rebuilds) slowed later plans, up to
+1.5× late in a long run (README, MotionBenchMaker section). The outcome is plain data too:
 the results row and the trajectory JSON text, written by the process that collects the outcomes.
 """
 
@@ -15,6 +18,7 @@ from pathlib import Path
 
 from ocpkit.bench.metrics import PLAN_METRICS, plan_metrics
 from ocpkit.bench.suite import Method, Scenario
+from ocpkit.build_cache import clear_builds
 from ocpkit.ladder import DEFAULT_LADDER
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import plan
@@ -77,8 +81,16 @@ def _plan_or_failed(problem: Problem, method: Method, options: dict) -> Plan:
                       extra={"error": error}, found=False)
 
 
+_planning: list[tuple[str, str]] = []  # the (suite, case) this process planned last (`run_task`)
+
+
 def run_task(task: dict) -> dict:
-    """Plan the task; return {"row": the results row (RUN_COLUMNS), "trajectory": the trajectory JSON text}."""
+    """Plan the task; return {"row": the results row (RUN_COLUMNS), "trajectory": the trajectory JSON text}.
+    The process's builds are cleared first if its last task was another scenario (module docstring)."""
+    scenario = (task["suite"], task["case"])
+    if _planning != [scenario]:
+        clear_builds()
+        _planning[:] = [scenario]
     started = time.perf_counter()
     problem = problem_from_dict(task["scenario"], name=task["case"])
     method = Method(**task["method"])

@@ -276,3 +276,22 @@ def test_a_planner_that_raises_gives_a_failed_row_naming_the_exception_not_a_cra
     assert row["status"] == "failed" and row["method"] == "ompl-toppra"
     assert json.loads(row["extra"])["error"] == "ompl-toppra raised ZeroDivisionError: a planner bug"
     assert json.loads(outcome["trajectory"])["status"] == "failed"
+
+
+def test_a_worker_keeps_its_builds_within_a_scenario_and_clears_them_when_the_scenario_changes(monkeypatch):
+    import ocpkit.bench.task as task_module
+    from ocpkit.bench.task import make_task, run_task
+
+    def broken(problem, **options):
+        raise ZeroDivisionError("not planned here")
+
+    cleared = []
+    monkeypatch.setattr(task_module, "plan", broken)
+    monkeypatch.setattr(task_module, "clear_builds", lambda: cleared.append(True))
+    monkeypatch.setattr(task_module, "_planning", [])
+    suite = load_suite(REPO / "suites/paper.yaml")
+    first, second = suite.scenarios[:2]
+    for scenario, method, repeat, clears in [(first, 0, 0, 1), (first, 0, 1, 1), (first, 1, 0, 1), (second, 0, 0, 2),
+                                             (first, 0, 0, 3)]:
+        run_task(make_task("paper", scenario, suite.methods[method], repeat))
+        assert len(cleared) == clears
