@@ -81,16 +81,17 @@ def _plan_or_failed(problem: Problem, method: Method, options: dict) -> Plan:
                       extra={"error": error}, found=False)
 
 
-_planning: list[tuple[str, str]] = []  # the (suite, case) this process planned last (`run_task`)
+_planning: tuple[str, str] | None = None  # the (suite, case) this process planned last (`run_task`)
 
 
 def run_task(task: dict) -> dict:
     """Plan the task; return {"row": the results row (RUN_COLUMNS), "trajectory": the trajectory JSON text}.
     The process's builds are cleared first if its last task was another scenario (module docstring)."""
+    global _planning
     scenario = (task["suite"], task["case"])
-    if _planning != [scenario]:
+    if _planning != scenario:
         clear_builds()
-        _planning[:] = [scenario]
+        _planning = scenario
     started = time.perf_counter()
     problem = problem_from_dict(task["scenario"], name=task["case"])
     method = Method(**task["method"])

@@ -288,7 +288,7 @@ def test_a_worker_keeps_its_builds_within_a_scenario_and_clears_them_when_the_sc
     cleared = []
     monkeypatch.setattr(task_module, "plan", broken)
     monkeypatch.setattr(task_module, "clear_builds", lambda: cleared.append(True))
-    monkeypatch.setattr(task_module, "_planning", [])
+    monkeypatch.setattr(task_module, "_planning", None)
     suite = load_suite(REPO / "suites/paper.yaml")
     first, second = suite.scenarios[:2]
     for scenario, method, repeat, clears in [(first, 0, 0, 1), (first, 0, 1, 1), (first, 1, 0, 1), (second, 0, 0, 2),
