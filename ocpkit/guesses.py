@@ -5,6 +5,7 @@ paper's cases: far slower than the optimum, so the first IPOPT iterations only s
 `line`: the same line over an estimated motion time, `motion_time_estimate`: the time a smooth
 (quintic) rest-to-rest motion along the line needs to keep within the velocity limits, lengthened until its
 inverse-dynamics torque keeps within the torque limits.
+`motion`: a given trajectory (any planner's, e.g. an earlier plan) sampled on the grid: a warm start.
 
 The simultaneous planner's default stays `paper`: `line` is faster on the paper cases, but it verified fewer of
 the shipped MBM problems and no more of the hard random suite (figures: docs/design-notes.md).
@@ -16,8 +17,10 @@ import dataclasses
 
 import numpy as np
 
+from ocpkit.errors import OptionError
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
+from ocpkit.trajectory import Trajectory
 from ocpkit.transcription import Discretization
 
 PEAK_SPEED = 1.875
@@ -63,3 +66,16 @@ def line_guess(problem: Problem, discretization: Discretization, fallback: bool 
     `paper_guess`."""
     timed = dataclasses.replace(problem.time, guess=motion_time_estimate(problem))
     return discretization.initial_guess(dataclasses.replace(problem, time=timed))
+
+
+def motion_guess(problem: Problem, discretization: Discretization, fallback: bool = True,
+                 trajectory: Trajectory | None = None) -> np.ndarray:
+    """`trajectory` (guess option: a Trajectory from start to goal, e.g. an earlier plan's) sampled on the grid;
+    `fallback` as for `paper_guess`."""
+    if not isinstance(trajectory, Trajectory):
+        raise OptionError(f"guess 'motion' needs a Trajectory to start from, got {trajectory!r} (Python API: "
+                          "plan(problem, guess='motion', guess_options={'trajectory': earlier_plan.trajectory}))")
+    joints = trajectory.knots.q.shape[1]
+    if joints != problem.robot.n:
+        raise OptionError(f"guess 'motion': the trajectory moves {joints} joints, the robot has {problem.robot.n}")
+    return discretization.encode(trajectory)

@@ -22,18 +22,33 @@ finds a path does not depend on the machine's speed. More knots resolve what a c
 continuation rung solves the problem relaxed first (a softened margin, wider limits) and the real one from there.
 The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
 shot finds in time.
+
+The default budget, MAX_WALL_TIME, leaves room for the first three rungs on a hard problem (MotionBenchMaker's
+shelves and cages: the capped first rung and two OMPL rungs, each a path search and its solves; figures:
+docs/design-notes.md). A verified plan returns at once; the budget is what a failure costs.
+
+A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
+every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
+options on a finer grid (one more pseudospectral segment; half as many intervals again for a local
+transcription), warm-started from that plan's motion. The residual is the interpolation error of the grid, and
+a motion that already meets every path constraint often converges on the finer one within a few dozen iterations;
+the size of the residual does not tell when, so the rung is capped at FINER_ITERATIONS to leave the later rungs
+their time (figures: docs/design-notes.md).
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ocpkit.plan import Plan, PlanStats
+from ocpkit.trajectory import Trajectory
 
 MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
+MAX_WALL_TIME = 90.0  # s of computation for the whole ladder, the simultaneous planner's default (docstring)
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path (about 20 s on one core)
+FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 
 
 @dataclass(frozen=True)
@@ -41,10 +56,11 @@ class Rung:
     """Option overrides of one attempt: `guess` ("line", "ompl" or None for the call's), OMPL `seed`, `knots`
     (None: the call's), pseudospectral `segments` of `knots` intervals each (None: the call's; a transcription
     without segments keeps the call's knots too), `max_iterations` per solve (None: the solver's; no
-    refinement round starts once the rung's solves have used that many), and
+    refinement round starts once the rung's solves have used that many),
     `relaxed`: a continuation, solving the problem relaxed (ocpkit.refine.RELAXED) first to warm-start the real
-    one. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's time
-    is up."""
+    one, and `refines`: a motion to re-solve on a finer grid than the rung's own (`finer`), its guess instead of
+    `guess`. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's
+    time is up."""
 
     name: str
     guess: str | None = None
@@ -53,6 +69,7 @@ class Rung:
     segments: int | None = None
     max_iterations: int | None = None
     relaxed: bool = False
+    refines: Trajectory | None = field(default=None, compare=False, repr=False)
 
 
 DEFAULT_LADDER: tuple[Rung, ...] = (
@@ -91,17 +108,32 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
     skipped: list[str] = []
+
+    def left() -> float:
+        return max_wall_time - sum(p.stats.solve_time for _, p in tried)
+
     for rung in ladder:
-        left = max_wall_time - sum(p.stats.solve_time for _, p in tried)
-        if tried and left <= 0:
+        if tried and left() <= 0:
             break
         if _repeats(rung, tried):
             skipped.append(rung.name)
             continue
-        tried.append((rung, attempt(rung, max(left, 0.0))))
+        tried.append((rung, attempt(rung, max(left(), 0.0))))
+        if (next_rung := finer(*tried[-1])) is not None and left() > 0:
+            tried.append((next_rung, attempt(next_rung, left())))
         if tried[-1][1].ok:
             break
     return _combined(tried, skipped)
+
+
+def finer(rung: Rung, plan: Plan) -> Rung | None:
+    """The rung re-solving `plan`'s motion on a finer grid (module docstring) when `plan`, planned on `rung`,
+    is violated only where refinement rounds cannot help; None otherwise, and for a rung that was itself one."""
+    if plan.status != "violated" or plan.verification.fixable or rung.refines is not None:
+        return None
+    cap = min(rung.max_iterations or FINER_ITERATIONS, FINER_ITERATIONS)
+    return dataclasses.replace(rung, name=f"{rung.name}-finer", max_iterations=cap, relaxed=False,
+                               refines=plan.trajectory)
 
 
 def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:

@@ -67,9 +67,9 @@ def round_timing(result: SolverResult, verify_time: float) -> dict:
 def next_refinement(previous: Refinement, verification: Verification, tf: float) -> Refinement | None:
     """The refinement after a converged solve with motion time tf (s) verified as `verification`; None when there
     is nothing to fix by one (verified, or no violation between check times)."""
-    fresh = verification.violation_times / tf
-    if verification.ok or not len(fresh):
+    if verification.ok or not verification.fixable:
         return None
+    fresh = verification.violation_times / tf
     excess = verification.limit_excess
     shrink = max(1.0 - excess - LIMIT_BACKOFF, MIN_SHRINK) if excess > 0 else 1.0
     return Refinement(np.concatenate([fresh, previous.check_fractions]),  # the newest take the slots

@@ -18,7 +18,7 @@ from ocpkit.build_cache import Build, build, construct
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
-from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung, climb
+from ocpkit.ladder import DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, Rung, climb
 from ocpkit.nlp import Refinement
 from ocpkit.plan import Plan, finish
 from ocpkit.planner import GUESSES
@@ -38,7 +38,7 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
                       refinements: int = DEFAULT_ROUNDS,
                       constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
                       transcription_options: dict | None = None, solver_options: dict | None = None,
-                      dynamics_options: dict | None = None, max_wall_time: float = 60.0,
+                      dynamics_options: dict | None = None, max_wall_time: float = MAX_WALL_TIME,
                       guess_options: dict | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER,
                       screen: bool | None = None) -> Plan:
     """Plan `problem` with path and timing together.
@@ -46,17 +46,17 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     `knots` is N, the intervals per segment of a pseudospectral transcription (K N + 1 points on K `segments`) or
     the mesh intervals of a local one; `guess` names a registered initial-guess rule ("paper", the default: the
     paper's line over t_f = time.guess; "line": the straight joint-space line over an estimated motion time,
-    ocpkit.guesses;
-    "ompl": the OMPL + TOPP-RA baseline's motion) or is a decision vector for this shape, with
+    ocpkit.guesses; "motion": a Trajectory given as guess option "trajectory"; "ompl": the OMPL + TOPP-RA
+    baseline's motion) or is a decision vector for this shape, with
     `guess_options` for the rule (e.g. {"seed": 3, "planning_time": 2.0} for "ompl", the baseline's options);
-    `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess is part of
-    the computation time; the one-time set-up is not. `max_wall_time` (s) bounds the computation
-    (guess, every solve and refinement round, every rung): each solve gets the time left (a solver that cannot
-    be interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when it
-    runs out. `fallbacks` is the ladder of rungs (ocpkit.ladder), each overriding these options, tried in order
+    `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess is part of the
+    computation time; the one-time set-up is not. `max_wall_time` (s; ocpkit.ladder.MAX_WALL_TIME) bounds the
+    computation (guess, every solve and refinement round, every rung): each solve gets the time left (a solver that
+    cannot be interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when
+    it runs out. `fallbacks` is the ladder of rungs (ocpkit.ladder), each overriding these options, tried in order
     until one plan verifies; () plans once with these options (SINGLE_SHOT, the paper's setting). `screen`: whether
-    the NLP carries only the collision rows near the motion (ocpkit.screening; None: whenever the robot and scene have
-    collision terms)."""
+    the NLP carries only the collision rows near the motion (ocpkit.screening; None: whenever the robot and scene
+    have collision terms)."""
     options = {"transcription": transcription, "knots": knots, "dynamics": dynamics, "solver": solver,
                "guess": guess, "refinements": refinements, "constraints": constraints,
                "transcription_options": transcription_options or {}, "solver_options": solver_options or {},
@@ -70,7 +70,8 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
     guess comes with its own options (its seed, and no fallback to the straight line: a rung without a start of
     its own ends `no_path` instead of repeating the line; an "ompl" rung's search budget, OMPL_CHECKS or the `left`
     seconds of the ladder) instead of the call's; the call's own max_iterations wins over a rung's cap, which caps
-    each solve and, as `iteration_budget`, the rung's refinement rounds and rebuilds."""
+    each solve and, as `iteration_budget`, the rung's refinement rounds and rebuilds. A rung that `refines` a
+    motion starts from it (guess "motion") on the finer grid."""
     if rung is None:
         return options
     changed = dict(options)
@@ -93,7 +94,18 @@ def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
         changed["iteration_budget"] = rung.max_iterations
     if rung.relaxed:
         changed["relaxed"] = True
+    if rung.refines is not None:
+        changed.update(_finer_grid(changed), guess="motion", guess_options={"trajectory": rung.refines})
     return changed
+
+
+def _finer_grid(options: dict) -> dict:
+    """The grid options of `options` refined (ocpkit.ladder.finer): one more segment of a pseudospectral
+    transcription, else half as many intervals again."""
+    if issubclass(TRANSCRIPTIONS.get(options["transcription"]), Pseudospectral):
+        segments = options["transcription_options"].get("segments", 1) + 1
+        return {"transcription_options": {**options["transcription_options"], "segments": segments}}
+    return {"knots": options["knots"] + (options["knots"] + 1) // 2}
 
 
 def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:

@@ -71,6 +71,12 @@ class Verification:
         return all(c.ok for c in self.checks)
 
     @property
+    def fixable(self) -> bool:
+        """Whether a refinement round has something to fix: a path-constraint violation between check times
+        (ocpkit.refine); a failed dynamics, boundary or consistency check alone is not."""
+        return len(self.violation_times) > 0
+
+    @property
     def limit_excess(self) -> float:
         """Largest relative excess over a velocity, torque or torque-rate limit beyond its tolerance, or 0."""
         return max([0.0] + [c.worst - c.tolerance for c in self.checks if c.name in SCALED_LIMITS])

@@ -3,6 +3,7 @@ rung overrides, OMPL rungs without a path, and the single shot of the paper."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -15,21 +16,26 @@ from ocpkit.bench import paper
 from ocpkit.bench import random as random_suite
 from ocpkit.bench.common import Results
 from ocpkit.cli import _planner_options, parser
-from ocpkit.errors import NoGuess
-from ocpkit.ladder import DEFAULT_LADDER, NO_PATH_HINT, OMPL_CHECKS, SINGLE_SHOT, Rung, climb, rank
+from ocpkit.errors import NoGuess, OptionError
+from ocpkit.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, SINGLE_SHOT, Rung, climb, finer,
+                           rank)
 from ocpkit.plan import Plan, PlanStats
 from ocpkit.planner import GUESSES
 from ocpkit.simultaneous import _capped, _overridden, plan_simultaneous
+from ocpkit.trajectory import Trajectory
 from ocpkit.verify import Check, Verification
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
 
 
-def fake(status: str, worst: float = 0.0, seconds: float = 1.0, iterations: int = 10) -> Plan:
-    """A plan with `status`, one obstacle check of `worst` m (failed if > 0), `seconds` of computation."""
-    check = Check("obstacle", worst, 0.0, 0.5, "m")
+def fake(status: str, worst: float = 0.0, seconds: float = 1.0, iterations: int = 10, check: str = "obstacle",
+         trajectory: object = None) -> Plan:
+    """A plan with `status`, one `check` of `worst` (failed if > 0; at t = 0.5 s a path violation a refinement
+    round can fix unless the check is "dynamics"), `seconds` of computation."""
+    times = np.array([0.5]) if worst > 0 and check != "dynamics" else np.zeros(0)
+    verification = Verification((Check(check, worst, 0.0, 0.5, "m"),), times)
     stats = PlanStats(seconds, 0.5, iterations, 1, f"{status} message", {"own": 1})
-    return Plan(None, status, Verification((check,), np.zeros(0)), stats, {"planner": "fake"})
+    return Plan(trajectory, status, verification, stats, {"planner": "fake"})
 
 
 class Script:
@@ -216,3 +222,71 @@ def test_a_rung_whose_guess_has_no_start_ends_no_path_before_any_solve(monkeypat
     monkeypatch.setitem(GUESSES._items, "nothing", nothing)
     plan = plan_simultaneous(CASE2, knots=6, fallbacks=(Rung("n", guess="nothing"),))
     assert plan.status == "no_path" and plan.stats.iterations == 0 and "no start here" in plan.stats.solver_message
+
+
+class Recording(Script):
+    """A Script that also records the rungs it was given."""
+
+    def __call__(self, rung: Rung | None, left: float) -> Plan:
+        self.rungs = [*getattr(self, "rungs", []), rung]
+        return super().__call__(rung, left)
+
+
+def test_a_plan_violated_only_by_the_dynamics_residual_is_re_solved_on_a_finer_grid_from_its_motion():
+    motion = object()
+    script = Recording({"a": fake("violated", 0.02, seconds=5.0, check="dynamics", trajectory=motion),
+                        "a-finer": fake("verified", seconds=2.0), "b": fake("verified")})
+    result = climb(script, LADDER, 20.0)
+    assert script.calls == [("a", 20.0), ("a-finer", 15.0)]
+    assert script.rungs[1].refines is motion and script.rungs[1].knots == LADDER[0].knots
+    assert result.ok and result.method["rung"] == "a-finer"
+
+
+@pytest.mark.parametrize("plan", [fake("violated", 0.02), fake("infeasible", 0.0, check="dynamics"),
+                                  fake("verified")])
+def test_no_finer_rung_follows_a_plan_a_refinement_round_could_fix_or_that_is_not_violated(plan):
+    assert finer(Rung("a"), plan) is None
+
+
+def test_a_finer_rung_is_capped_and_not_refined_again_nor_relaxed():
+    plan = fake("violated", 0.02, check="dynamics", trajectory=object())
+    rung = finer(Rung("a", guess="ompl", seed=2, segments=3, max_iterations=300, relaxed=True), plan)
+    assert (rung.name, rung.segments, rung.max_iterations, rung.relaxed) == ("a-finer", 3, FINER_ITERATIONS, False)
+    assert finer(Rung("a", max_iterations=50), plan).max_iterations == 50
+    assert finer(Rung("a"), plan).max_iterations == FINER_ITERATIONS
+    assert finer(rung, plan) is None
+    script = Script({"a": plan, "a-finer": fake("violated", 0.01, check="dynamics"), "b": fake("infeasible"),
+                     "c": fake("infeasible")})
+    climb(script, LADDER, 60.0)
+    assert [name for name, _ in script.calls] == ["a", "a-finer", "b", "c"]
+
+
+@pytest.mark.parametrize("transcription, options, rung, grid", [
+    ("chebyshev", {}, Rung("x"), (12, {"segments": 2})),
+    ("chebyshev", {"segments": 2}, Rung("x", knots=6, segments=3), (6, {"segments": 4})),
+    ("lgl", {"staged": False}, Rung("x"), (12, {"staged": False, "segments": 2})),
+    ("trapezoidal", {}, Rung("x", knots=6, segments=3), (18, {})),
+    ("hermite-simpson", {}, Rung("x", knots=15), (23, {}))])
+def test_a_finer_rung_adds_a_segment_or_half_the_intervals_and_starts_from_the_motion(transcription, options,
+                                                                                      rung, grid):
+    motion = object()
+    call = {"guess": "paper", "guess_options": {}, "knots": 12, "transcription": transcription,
+            "transcription_options": options, "solver_options": {}}
+    changed = _overridden(call, dataclasses.replace(rung, refines=motion), 9.0)
+    assert (changed["knots"], changed["transcription_options"]) == grid
+    assert changed["guess"] == "motion" and changed["guess_options"] == {"trajectory": motion}
+
+
+def test_the_motion_guess_samples_a_trajectory_on_another_grid():
+    plan = plan_simultaneous(CASE2, knots=6, fallbacks=SINGLE_SHOT)
+    coarse = plan.trajectory
+    discretization = ocpkit.build(CASE2, knots=6, transcription_options={"segments": 2}).discretization
+    w = GUESSES.get("motion")(CASE2, discretization, trajectory=coarse)
+    sampled = discretization.decode(w)
+    assert sampled.tf == pytest.approx(coarse.tf)
+    np.testing.assert_allclose(sampled.knots.q, coarse.interpolant(sampled.knots.t).q, atol=1e-9)
+    with pytest.raises(OptionError, match="guess 'motion' needs"):
+        GUESSES.get("motion")(CASE2, discretization)
+    fewer = Trajectory(dataclasses.replace(coarse.knots, q=coarse.knots.q[:, :5]), coarse.interpolant)
+    with pytest.raises(OptionError, match="moves 5 joints, the robot has 6"):
+        GUESSES.get("motion")(CASE2, discretization, trajectory=fewer)

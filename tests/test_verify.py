@@ -65,6 +65,15 @@ def test_torque_that_does_not_match_the_motion_fails_dynamics():
     assert checks["dynamics"].worst == pytest.approx(30.0 / (2 * PROBLEM.robot.tau_max).min(), rel=1e-6)
 
 
+def test_only_path_constraint_violations_are_fixable_by_a_refinement_round():
+    free = dataclasses.replace(PROBLEM, scene=dataclasses.replace(PROBLEM.scene, obstacle_centers=np.zeros((0, 3)),
+                                                                  obstacle_radii=np.zeros(0)))
+    mismatched = verify(free, quintic(free, 4.0, tau_offset=30.0))
+    assert not mismatched.ok and not mismatched.fixable  # the dynamics alone: only a finer grid helps
+    assert verify(PROBLEM, quintic(PROBLEM, 4.0)).fixable  # through the obstacle
+    assert verify(free, quintic(free, 0.3)).fixable  # over the velocity limit
+
+
 def test_wrong_goal_fails_boundary():
     moved = dataclasses.replace(PROBLEM, goal=PROBLEM.goal + 0.01)
     assert not by_name(verify(moved, quintic(PROBLEM, 4.0)))["boundary"].ok
