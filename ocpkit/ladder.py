@@ -101,9 +101,10 @@ def rank(plan: Plan) -> tuple[int, float]:
 
 
 def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:
-    """Plan with `attempt(rung, seconds left)` on each rung of `ladder` in turn (on None once if it is empty)
-    until one verifies or the `max_wall_time` (s) of computation is spent; the first verified plan, else the
-    best by `rank`, with the stats of all attempts (module docstring)."""
+    """Plan with `attempt(rung, seconds left)` on each rung of `ladder` in turn, each followed by its `finer` rung
+    when its plan calls for one (on None once if the ladder is empty), until one verifies or the `max_wall_time` (s)
+    of computation is spent; the first verified plan, else the best by `rank`, with the stats of all attempts
+    (module docstring)."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
