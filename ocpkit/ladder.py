@@ -133,8 +133,8 @@ def finer(rung: Rung, plan: Plan) -> Rung | None:
     if plan.status != "violated" or plan.verification.fixable or rung.refines is not None:
         return None
     cap = min(rung.max_iterations or FINER_ITERATIONS, FINER_ITERATIONS)
-    return dataclasses.replace(rung, name=f"{rung.name}-finer", max_iterations=cap, relaxed=False,
-                               refines=plan.trajectory)
+    return dataclasses.replace(rung, name=f"{rung.name}-finer", guess=None, seed=None, max_iterations=cap,
+                               relaxed=False, refines=plan.trajectory)
 
 
 def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:

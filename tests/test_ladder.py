@@ -252,6 +252,7 @@ def test_a_finer_rung_is_capped_and_not_refined_again_nor_relaxed():
     plan = fake("violated", 0.02, check="dynamics", trajectory=object())
     rung = finer(Rung("a", guess="ompl", seed=2, segments=3, max_iterations=300, relaxed=True), plan)
     assert (rung.name, rung.segments, rung.max_iterations, rung.relaxed) == ("a-finer", 3, FINER_ITERATIONS, False)
+    assert (rung.guess, rung.seed, rung.refines) == (None, None, plan.trajectory)  # its start is the motion
     assert finer(Rung("a", max_iterations=50), plan).max_iterations == 50
     assert finer(Rung("a"), plan).max_iterations == FINER_ITERATIONS
     assert finer(rung, plan) is None
