@@ -9,14 +9,14 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from ocpkit.build_cache import Build, build  # noqa: E402
-from ocpkit.plan import Plan  # noqa: E402
+from ocpkit.formats.scenario import load_scenario  # noqa: E402
+from ocpkit.formats.trajectory import Trajectory, write_json  # noqa: E402
+from ocpkit.geometry.scene import Scene, Workspace  # noqa: E402
 from ocpkit.planner import plan  # noqa: E402
+from ocpkit.planner.build_cache import Build, build  # noqa: E402
 from ocpkit.problem import Problem, TimeBounds  # noqa: E402
+from ocpkit.result import Plan  # noqa: E402
 from ocpkit.robots import Robot, load_robot  # noqa: E402
-from ocpkit.scenario import load_scenario  # noqa: E402
-from ocpkit.scene import Scene, Workspace  # noqa: E402
-from ocpkit.trajectory import Trajectory, write_json  # noqa: E402
 from ocpkit.verify import Verification, verify  # noqa: E402
 
 __all__ = ["Build", "Plan", "Problem", "Robot", "Scene", "TimeBounds", "Trajectory", "Verification", "Workspace",

@@ -124,7 +124,7 @@ class NLP:
 class Refinement:
     """What a refinement round may change without a rebuild: where the adaptive check slots sit (fractions of
     t_f, newest first), how much the clearance margin grows (m), and the fraction of the velocity, torque and
-    torque-rate limits the NLP may use. The policy that chooses them is `ocpkit.refine`."""
+    torque-rate limits the NLP may use. The policy that chooses them is `ocpkit.planner.refinement`."""
 
     check_fractions: np.ndarray = field(default_factory=lambda: np.zeros(0))
     extra_margin: float = 0.0

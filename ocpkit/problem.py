@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ocpkit.geometry import Clearances, clearances, sphere_centers_batch
+from ocpkit.geometry.clearances import Clearances, clearances, sphere_centers_batch
+from ocpkit.geometry.scene import Scene
 from ocpkit.robots import Robot
-from ocpkit.scene import Scene
 
 
 @dataclass(frozen=True)

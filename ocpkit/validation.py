@@ -13,11 +13,11 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.errors import ScenarioError
-from ocpkit.geometry import collision_report
+from ocpkit.formats.schema import COST, OBSTACLE, TIME, WORKSPACE, check, show
+from ocpkit.geometry.clearances import collision_report
+from ocpkit.geometry.scene import Scene
 from ocpkit.problem import Problem, TimeBounds
 from ocpkit.robots import Robot
-from ocpkit.scene import Scene
-from ocpkit.schema import COST, OBSTACLE, TIME, WORKSPACE, check, show
 
 LIMIT_SLACK = 1e-9  # rad: a start or goal exactly at a limit, given in degrees, must not fail on round-off
 SHOWN_CONTACTS = 3  # contacts named in a start/goal collision error; the rest are counted

@@ -29,17 +29,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ocpkit.geometry import clearances, sphere_centers_batch
+from ocpkit.formats.trajectory import TIME_TOLERANCE, Samples, Trajectory, time_excess
+from ocpkit.geometry.clearances import clearances, sphere_centers_batch
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
-from ocpkit.trajectory import TIME_TOLERANCE, Samples, Trajectory, time_excess
+from ocpkit.tolerances import (
+    BOUNDARY_TOLERANCE,
+    DYNAMICS_TOLERANCE,
+    GEOMETRY_TOLERANCE,
+    LIMIT_TOLERANCE,
+    QD_CONSISTENCY_TOLERANCE,
+    QDD_CONSISTENCY_TOLERANCE,
+)
 
-LIMIT_TOLERANCE = 0.01
-DYNAMICS_TOLERANCE = 0.01
-GEOMETRY_TOLERANCE = 0.0
-BOUNDARY_TOLERANCE = 1e-6
-QD_CONSISTENCY_TOLERANCE = 0.01
-QDD_CONSISTENCY_TOLERANCE = 0.05
 GEOMETRY_CHECKS = ("self_collision", "obstacle", "workspace")
 SCALED_LIMITS = ("velocity", "torque", "torque_rate")
 
@@ -73,7 +75,7 @@ class Verification:
     @property
     def fixable(self) -> bool:
         """Whether a refinement round has something to fix: a path-constraint violation between check times
-        (ocpkit.refine); a failed dynamics, boundary or consistency check alone is not."""
+        (ocpkit.planner.refinement); a failed dynamics, boundary or consistency check alone is not."""
         return len(self.violation_times) > 0
 
     @property

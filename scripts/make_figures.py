@@ -24,8 +24,8 @@ import numpy as np  # noqa: E402
 
 from ocpkit import load_scenario, plan  # noqa: E402
 from ocpkit.bench.convergence import plot_convergence, read_rows, run_convergence  # noqa: E402
-from ocpkit.build_cache import build  # noqa: E402
-from ocpkit.geometry import clearances, sphere_centers  # noqa: E402
+from ocpkit.planner.build_cache import build  # noqa: E402
+from ocpkit.geometry.clearances import clearances, sphere_centers  # noqa: E402
 from ocpkit.transcription.polynomials import differentiation_matrix, lobatto_points  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent

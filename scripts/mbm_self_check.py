@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ocpkit.geometry import collision_report
+from ocpkit.geometry.clearances import collision_report
 from ocpkit.robots import Robot, builtin_robots, load_robot
 from ocpkit.robots.robot import robot_from_spec
-from ocpkit.scene import Scene
+from ocpkit.geometry.scene import Scene
 
 
 def start_goal(request: dict, joints: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:

@@ -2,20 +2,23 @@
 
 from __future__ import annotations
 
+import copy
 import importlib.metadata
 from pathlib import Path
 
 import casadi as ca
 import numpy as np
+import pinocchio as pin
 import pytest
 from numpy.polynomial import Polynomial
 
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
+from ocpkit.formats.scenario import problem_from_dict
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.nlp import Refinement
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
-from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 
 REPO = Path(__file__).resolve().parents[1]
@@ -72,3 +75,25 @@ def polynomial_motion(problem: Problem, tf: float, shape: Polynomial) -> Traject
 def monomial(degree: int) -> Polynomial:
     """s ↦ s^degree."""
     return Polynomial([0.0] * degree + [1.0])
+
+
+def quintic(problem, tf: float, tau_offset: float = 0.0) -> Trajectory:
+    """Rest-to-rest minimum-jerk motion start → goal in tf seconds, with its exact inverse-dynamics torque."""
+    robot, delta = problem.robot, problem.goal - problem.start
+    data = robot.model.createData()
+
+    def at(t: np.ndarray) -> Samples:
+        x = np.clip(np.asarray(t) / tf, 0, 1)[:, None]
+        s = 10 * x**3 - 15 * x**4 + 6 * x**5
+        ds = (30 * x**2 - 60 * x**3 + 30 * x**4) / tf
+        dds = (60 * x - 180 * x**2 + 120 * x**3) / tf**2
+        q, qd, qdd = problem.start + s * delta, ds * delta, dds * delta
+        tau = np.array([pin.rnea(robot.model, data, *row).copy() for row in zip(q, qd, qdd)]) + robot.friction(qd)
+        return Samples(np.asarray(t), q, qd, qdd, tau + tau_offset, np.gradient(tau, np.asarray(t), axis=0))
+
+    return Trajectory(at(np.array([0.0, tf])), at)
+
+
+def load(data: dict) -> Problem:
+    """The Problem of scenario `data` (a copy: the caller's dict is untouched), paths relative to the repository."""
+    return problem_from_dict(copy.deepcopy(data), base_dir=REPO)

@@ -14,10 +14,10 @@ import yaml
 from helpers import REPO
 
 import ocpkit
-from ocpkit.cli import main
+from ocpkit.cli.main import main
 from ocpkit.errors import ScenarioError
+from ocpkit.geometry.scene import Scene, Workspace
 from ocpkit.problem import TimeBounds
-from ocpkit.scene import Scene, Workspace
 
 ROBOT_DIR = REPO / "ocpkit/robots/data/industrial6"
 SCENARIO = yaml.safe_load((REPO / "scenarios/paper/case1.yaml").read_text())

@@ -11,14 +11,14 @@ import pytest
 from helpers import REPO
 
 import ocpkit
-from ocpkit.build_cache import build
 from ocpkit.constraints import DEFAULT_CONSTRAINTS
 from ocpkit.errors import OptionError
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.nlp import Layout
-from ocpkit.refine import checked, solve_refined
-from ocpkit.simultaneous import plan_simultaneous
+from ocpkit.planner.build_cache import build
+from ocpkit.planner.refinement import checked, solve_refined
+from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.solvers import PreparedSolver, SolverResult, SolverStatus
-from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.verify import verify
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")

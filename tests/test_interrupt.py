@@ -14,7 +14,7 @@ from helpers import REPO
 
 from ocpkit import interrupt
 
-OCPKIT = [sys.executable, "-m", "ocpkit.cli"]
+OCPKIT = [sys.executable, "-m", "ocpkit.cli.main"]
 
 
 def cpu_seconds(pid: int) -> float:

@@ -12,10 +12,10 @@ from helpers import REPO, monomial, polynomial_motion
 from outside_check import check
 
 import ocpkit
-from ocpkit.report import trajectory_header
-from ocpkit.scene import Scene
-from ocpkit.trajectory import Samples, Trajectory, write_json
-from ocpkit.plan import finish
+from ocpkit.formats.record import trajectory_header
+from ocpkit.formats.trajectory import Samples, Trajectory, write_json
+from ocpkit.geometry.scene import Scene
+from ocpkit.result import finish
 
 DATA = REPO / "ocpkit/robots/data/industrial6"
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")

@@ -7,7 +7,7 @@ import pytest
 from helpers import REPO
 
 import ocpkit
-from ocpkit.cli import main
+from ocpkit.cli.main import main
 from ocpkit.errors import RegistryError
 from ocpkit.transcription import TRANSCRIPTIONS
 

@@ -5,31 +5,13 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import pinocchio as pin
 import pytest
-from helpers import REPO
+from helpers import REPO, quintic
 
 from ocpkit import load_scenario, verify
-from ocpkit.trajectory import Samples, Trajectory
+from ocpkit.formats.trajectory import Samples, Trajectory
 
 PROBLEM = load_scenario(REPO / "scenarios/paper/case2.yaml")
-
-
-def quintic(problem, tf: float, tau_offset: float = 0.0) -> Trajectory:
-    """Rest-to-rest minimum-jerk motion start → goal in tf seconds, with its exact inverse-dynamics torque."""
-    robot, delta = problem.robot, problem.goal - problem.start
-    data = robot.model.createData()
-
-    def at(t: np.ndarray) -> Samples:
-        x = np.clip(np.asarray(t) / tf, 0, 1)[:, None]
-        s = 10 * x**3 - 15 * x**4 + 6 * x**5
-        ds = (30 * x**2 - 60 * x**3 + 30 * x**4) / tf
-        dds = (60 * x - 180 * x**2 + 120 * x**3) / tf**2
-        q, qd, qdd = problem.start + s * delta, ds * delta, dds * delta
-        tau = np.array([pin.rnea(robot.model, data, *row).copy() for row in zip(q, qd, qdd)]) + robot.friction(qd)
-        return Samples(np.asarray(t), q, qd, qdd, tau + tau_offset, np.gradient(tau, np.asarray(t), axis=0))
-
-    return Trajectory(at(np.array([0.0, tf])), at)
 
 
 def by_name(verification):

@@ -26,16 +26,25 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ocpkit.baselines.ompl_toppra import (MAX_STEP, _hold, _import_backends, _no_path, _ompl_path, _smooth_path,
-                                         _time_optimal, check_ompl_planner, planning_space)
-from ocpkit.build_cache import build
+from ocpkit.baselines.ompl_toppra import (
+    MAX_STEP,
+    _hold,
+    _import_backends,
+    _no_path,
+    _ompl_path,
+    _smooth_path,
+    _time_optimal,
+    check_ompl_planner,
+    planning_space,
+)
 from ocpkit.dynamics import Dynamics
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import PathSpline
-from ocpkit.plan import Plan, finish
+from ocpkit.planner.build_cache import build
+from ocpkit.planner.refinement import DEFAULT_ROUNDS, Refined, solve_refined
 from ocpkit.problem import Problem
-from ocpkit.refine import DEFAULT_ROUNDS, Refined, solve_refined
+from ocpkit.result import Plan, finish
 from ocpkit.solvers import SolverStatus
-from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription.ocp import PathTimingOCP
 
 PIECES_STEP = 4  # the path's polynomial pieces are rounded up to a multiple of this: one NLP per multiple

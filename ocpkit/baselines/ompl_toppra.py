@@ -56,11 +56,11 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.errors import NoGuess, OptionError, RegistryError
-from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.plan import Plan, finish
+from ocpkit.formats.trajectory import Samples, Trajectory
+from ocpkit.geometry.clearances import clearances, sphere_centers
 from ocpkit.problem import Problem
+from ocpkit.result import Plan, finish
 from ocpkit.robots import Robot, rigid_torque
-from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription import Discretization
 
 OMPL_PLANNERS = {"rrtconnect": "RRTConnect", "rrtstar": "RRTstar", "bitstar": "BITstar", "prm": "PRM"}

@@ -14,11 +14,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ocpkit.errors import ScenarioError
-from ocpkit.plan import Plan
+from ocpkit.formats.record import KEY_COLUMNS, RESULT_COLUMNS, row_key
+from ocpkit.formats.scenario import load_scenario
 from ocpkit.planner import plan
 from ocpkit.problem import Problem
-from ocpkit.report import KEY_COLUMNS, RESULT_COLUMNS, row_key
-from ocpkit.scenario import load_scenario
+from ocpkit.result import Plan
 
 
 @dataclass(frozen=True)

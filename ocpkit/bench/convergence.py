@@ -35,9 +35,9 @@ from pathlib import Path
 import numpy as np
 
 from ocpkit.bench.common import measure, write_csv
+from ocpkit.formats.scenario import load_scenario
+from ocpkit.geometry.scene import Scene
 from ocpkit.problem import Problem
-from ocpkit.scenario import load_scenario
-from ocpkit.scene import Scene
 from ocpkit.transcription.base import TRANSCRIPTIONS
 
 DEFAULT_CASE = Path("scenarios/paper/case2.yaml")

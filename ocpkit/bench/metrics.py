@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from ocpkit.formats.trajectory import Samples
 from ocpkit.robots import Robot
-from ocpkit.trajectory import Samples
 
 PLAN_METRICS = ("path_length_rad", "ee_path_length_m", "peak_torque_use", "peak_torque_rate_use")
 """The per-plan columns of a `bench run` results.csv (empty when the planner found no trajectory)."""

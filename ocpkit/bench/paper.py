@@ -24,11 +24,18 @@ from ocpkit.bench.common import (
     reported_on_interrupt,
     resumed_line,
 )
-from ocpkit.ladder import SINGLE_SHOT
-from ocpkit.plan import Plan
+from ocpkit.formats.record import (
+    KEY_COLUMNS,
+    RESULT_COLUMNS,
+    Recorded,
+    result_row,
+    row_key,
+    trajectory_header,
+)
+from ocpkit.formats.trajectory import write_json
+from ocpkit.planner.ladder import SINGLE_SHOT
 from ocpkit.problem import Problem
-from ocpkit.report import KEY_COLUMNS, RESULT_COLUMNS, Recorded, result_row, row_key, trajectory_header
-from ocpkit.trajectory import write_json
+from ocpkit.result import Plan
 
 PAPER_TF = {12: [1.65, 1.23, 1.05, 1.08], 8: [1.98, 1.23, 1.09, 1.11]}
 PAPER_SOLVE = {12: [2.55, 2.37, 2.39, 2.57], 8: [1.28, 1.75, 0.84, 1.32]}
@@ -186,7 +193,7 @@ def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ..
 
 
 def _guess_table(problems: list[Problem], paper: dict, default: dict, counts: tuple[int, ...]) -> str:
-    """The paper's guess (straight line, t_f = time.guess) beside the timed line (ocpkit.guesses) per knot count."""
+    """The paper's guess (straight line, t_f = time.guess) beside the timed line (ocpkit.planner.guesses) per knot count."""
     lines = ["", f"Initial guess: the paper's ({PAPER_GUESS}: straight line over t_f = time.guess) vs the timed line "
              f"({TIMED_GUESS}: straight line over a velocity/torque estimate of t_f), single shot",
              f"{'guess':<8}{'knots':>6}{'median computation':>20}{'iterations':>12}{'per case':>18}{'verified':>10}"]

@@ -31,15 +31,15 @@ from tqdm import tqdm
 
 from ocpkit.bench.common import load_all, machine
 from ocpkit.bench.paper import PAPER_SETUP
-from ocpkit.build_cache import clear_builds
-from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.ladder import SINGLE_SHOT
-from ocpkit.plan import Plan
+from ocpkit.geometry.clearances import clearances, sphere_centers
+from ocpkit.geometry.scene import Scene
 from ocpkit.planner import plan
+from ocpkit.planner.build_cache import clear_builds
+from ocpkit.planner.ladder import SINGLE_SHOT
+from ocpkit.planner.refinement import CALLBACKS
 from ocpkit.problem import Problem, TimeBounds
-from ocpkit.refine import CALLBACKS
+from ocpkit.result import Plan
 from ocpkit.robots import load_robot
-from ocpkit.scene import Scene
 
 PAPER_COMPUTATION = {12: 2.47, 8: 1.30}
 """The paper's median computation time (s) at 12 and 8 knots."""
@@ -71,7 +71,7 @@ class Sample:
 
 
 def sample(result: Plan, linear_share: float = 0.0) -> Sample:
-    """The figures of one simultaneous plan from its stats (stats.extra["timing"], ocpkit.simultaneous);
+    """The figures of one simultaneous plan from its stats (stats.extra["timing"], ocpkit.planner.simultaneous);
     `linear_share`: the fraction of IPOPT's own work (its call less the callbacks) in linear solves."""
     timing = result.stats.extra.get("timing", {})
     rounds = timing.get("rounds", [])
@@ -178,7 +178,7 @@ def summary_table(splits: dict[str, dict[int, list[Sample]]]) -> str:
              f"{'verified':>10}{'set-up':>9}{'graph':>8}{'solver':>8}{'compile':>9}{'paper':>7}"]
     for guess, split in splits.items():
         lines += [f"{guess:<7}" + _summary_row(n, samples) for n, samples in split.items()]
-    lines.append("line: the timed line guess (ocpkit.guesses); paper: the paper's (straight line over t_f = 10 s); "
+    lines.append("line: the timed line guess (ocpkit.planner.guesses); paper: the paper's (straight line over t_f = 10 s); "
                  "compile: C compiled in the set-up, 0 when the disk cache had it")
     return "\n".join(lines)
 

@@ -29,15 +29,15 @@ import yaml
 from ocpkit.baselines.ompl_toppra import joint_path
 from ocpkit.bench.common import machine
 from ocpkit.errors import ScenarioError
-from ocpkit.geometry import sphere_centers
-from ocpkit.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung
-from ocpkit.plan import Plan
+from ocpkit.formats.record import RESULT_COLUMNS, result_row, trajectory_header
+from ocpkit.formats.trajectory import write_json
+from ocpkit.geometry.clearances import sphere_centers
+from ocpkit.geometry.scene import Scene, Workspace
 from ocpkit.planner import plan
+from ocpkit.planner.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung
 from ocpkit.problem import Problem, TimeBounds
-from ocpkit.report import RESULT_COLUMNS, result_row, trajectory_header
+from ocpkit.result import Plan
 from ocpkit.robots import Robot, load_robot
-from ocpkit.scene import Scene, Workspace
-from ocpkit.trajectory import write_json
 from ocpkit.validation import validate
 
 LOWER_DEG = [-150, -60, -60, -170, -110, -170]

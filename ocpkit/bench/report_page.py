@@ -26,8 +26,8 @@ import numpy as np  # noqa: E402
 from ocpkit.bench.arena import write_arena_logs  # noqa: E402
 from ocpkit.bench.metrics import formatted, success_grid, summarize  # noqa: E402
 from ocpkit.errors import OptionError  # noqa: E402
+from ocpkit.formats.scenario import load_scenario  # noqa: E402
 from ocpkit.robots import Robot  # noqa: E402
-from ocpkit.scenario import load_scenario  # noqa: E402
 
 DPI = 100
 

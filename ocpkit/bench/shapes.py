@@ -9,12 +9,12 @@ import dataclasses
 from pathlib import Path
 
 from ocpkit.bench.common import machine, measure
-from ocpkit.build_cache import build
 from ocpkit.constraints.collision import SphereCollision
-from ocpkit.ladder import SINGLE_SHOT
+from ocpkit.formats.scenario import load_scenario
+from ocpkit.geometry.scene import Boxes, Cylinders
+from ocpkit.planner.build_cache import build
+from ocpkit.planner.ladder import SINGLE_SHOT
 from ocpkit.problem import Problem
-from ocpkit.scenario import load_scenario
-from ocpkit.scene import Boxes, Cylinders
 
 DEFAULT_SCENARIO = Path("scenarios/shapes/boxes.yaml")
 

@@ -19,8 +19,8 @@ from pathlib import Path
 from ocpkit.bench.common import Measured, load_all, machine, measure, write_csv
 from ocpkit.dynamics import DYNAMICS
 from ocpkit.errors import OcpkitError
+from ocpkit.formats.record import RESULT_COLUMNS, max_violation, result_row
 from ocpkit.problem import Problem
-from ocpkit.report import RESULT_COLUMNS, max_violation, result_row
 from ocpkit.solvers import SOLVERS
 
 VARIANTS = {"sqpmethod": ((("qpsol", "osqp"),),)}

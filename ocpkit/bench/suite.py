@@ -1,6 +1,6 @@
 """Suite files of `ocpkit bench run`: scenario sources × a grid of methods × repeats (README, 'Benchmark suites').
 
-A suite is checked with the project schema (ocpkit.schema; errors name the field, e.g. `methods[1].knots`),
+A suite is checked with the project schema (ocpkit.formats.schema; errors name the field, e.g. `methods[1].knots`),
 every scenario is loaded and validated, and every method's options are checked against its planner, all before
 the first plan. `tasks` then gives one plain-data `Task` per (scenario, method, repeat), which any worker process
 or Dask worker can run (ocpkit.bench.task).
@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from ocpkit.errors import OcpkitError, within
-from ocpkit.schema import (
+from ocpkit.formats.schema import (
     Choice,
     Mapping,
     Number,
@@ -176,7 +176,7 @@ def _paths(patterns: list[str], base: Path, where: str) -> tuple[list[Scenario],
 
 def _from_file(file: Path, scene: str) -> Scenario:
     """The Scenario of a scenario file, loaded and validated now (its errors name the file)."""
-    from ocpkit.scenario import load_scenario
+    from ocpkit.formats.scenario import load_scenario
 
     problem = load_scenario(file)  # validates, naming the file
     with within(file):
@@ -236,7 +236,9 @@ def _rejected(scene: Path) -> dict[str, str]:
 
 
 def _random(body: dict, base: Path, where: str) -> tuple[list[Scenario], list[str]]:
-    from ocpkit.bench.random import _scenario as scenario_data  # the random suite's own file content
+    from ocpkit.bench.random import (
+        _scenario as scenario_data,  # the random suite's own file content
+    )
     from ocpkit.bench.random import random_problems
 
     seed, low_high = body.get("seed", 1), tuple(body.get("obstacles", (1, 1)))
@@ -287,9 +289,9 @@ def _method(data: dict, where: str) -> Method:
 def _check_transcription(options: dict[str, Any], where: str) -> None:
     """SuiteError now if the transcription, solver or dynamics is unknown or the transcription does not take the
     knots (and segments)."""
-    from ocpkit.build_cache import construct
     from ocpkit.dynamics import DYNAMICS
     from ocpkit.planner import GUESSES
+    from ocpkit.planner.build_cache import construct
     from ocpkit.solvers import SOLVERS
     from ocpkit.transcription import TRANSCRIPTIONS
 

@@ -2,7 +2,7 @@
 
 A task is plain data (a dict: the scenario mapping, case, scene, method, repeat, suite), so a local worker
 process or a Dask worker on another machine can run it; each process keeps its own build cache
-(ocpkit.build_cache) while it plans one scenario, so its later methods and repeats of a shape it has built skip
+(ocpkit.planner.build_cache) while it plans one scenario, so its later methods and repeats of a shape it has built skip
 the set-up, and clears it when the scenario changes: builds held from earlier problems (about 400 MB each for a
 7-joint MBM problem, several per plan with the ladder's rungs and screening rebuilds) slowed later plans, up to
 1.5× late in a long run (README, MotionBenchMaker section). The outcome is plain data too:
@@ -18,20 +18,20 @@ from pathlib import Path
 
 from ocpkit.bench.metrics import PLAN_METRICS, plan_metrics
 from ocpkit.bench.suite import Method, Scenario
-from ocpkit.build_cache import clear_builds
-from ocpkit.ladder import DEFAULT_LADDER
-from ocpkit.plan import Plan, finish
+from ocpkit.formats.record import RESULT_COLUMNS, result_row, trajectory_header
+from ocpkit.formats.scenario import problem_from_dict
+from ocpkit.formats.trajectory import write_json
 from ocpkit.planner import plan
+from ocpkit.planner.build_cache import clear_builds
+from ocpkit.planner.ladder import DEFAULT_LADDER
 from ocpkit.problem import Problem
-from ocpkit.report import RESULT_COLUMNS, result_row, trajectory_header
-from ocpkit.scenario import problem_from_dict
-from ocpkit.trajectory import write_json
+from ocpkit.result import Plan, finish
 
 RUN_KEY_COLUMNS = ("suite", "scene", "case", "method", "repeat")
 """What names a row of a `bench run` results.csv: one per (scenario, method, repeat)."""
 RUN_COLUMNS = (*RESULT_COLUMNS, "robot", "scene", "method", "repeat", "guess", "seed", "wall_time_s",
                *PLAN_METRICS, "trajectory")
-"""The columns of a `bench run` results.csv: those of ocpkit.report, the robot, scene, method label, repeat
+"""The columns of a `bench run` results.csv: those of ocpkit.formats.record, the robot, scene, method label, repeat
 (0-based), the initial guess and OMPL seed of the reported plan (the verified fallback rung's; empty where the
 plan used none), the task's wall time (s, set-up
 included) and the per-plan metrics (ocpkit.bench.metrics), and the trajectory file relative to the output."""
@@ -57,7 +57,7 @@ def trajectory_file(task: dict) -> str:
 
 def _guess_and_seed(planner: str, options: dict, seed: int | None, rung_name: str | None) -> tuple[str, int | None]:
     """The initial guess and OMPL seed of the plan a row reports: for the simultaneous planner, those of the
-    fallback-ladder rung that gave it (ocpkit.ladder) where the rung overrides the method's; no guess otherwise."""
+    fallback-ladder rung that gave it (ocpkit.planner.ladder) where the rung overrides the method's; no guess otherwise."""
     if planner != "simultaneous":
         return "", seed
     rung = next((r for r in options.get("fallbacks", DEFAULT_LADDER) if r.name == rung_name), None)

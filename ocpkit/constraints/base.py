@@ -101,7 +101,7 @@ class Constraint(ABC):
 
     def screened(self, problem: Problem, near: np.ndarray, distance: float) -> Constraint:
         """This constraint for `problem` without the rows that stay inactive by more than `distance` (its own unit)
-        at every configuration of `near` (K, n) (ocpkit.screening); itself when it has nothing to leave out."""
+        at every configuration of `near` (K, n) (ocpkit.planner.screening); itself when it has nothing to leave out."""
         return self
 
     def missing(self, problem: Problem, near: np.ndarray, distance: float) -> int:

@@ -17,7 +17,7 @@ constraint's shape: moving an obstacle keeps the build unless it crosses a spher
 on the fixed base never move at all; they are checked once, when the problem is validated. The clearance
 margin is an NLP parameter (a refinement round may raise it), so terms are kept up to MAX_MARGIN.
 `screened` goes further for robots with many terms: it keeps only the terms near given configurations (the
-planner's active set, ocpkit.screening); the pairs and terms kept are then part of the shape too.
+planner's active set, ocpkit.planner.screening); the pairs and terms kept are then part of the shape too.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ import casadi as ca
 import numpy as np
 
 from ocpkit.constraints.base import Constraint, Context, PointValues, Rows
-from ocpkit.geometry import clearances, sphere_centers_batch
+from ocpkit.geometry.clearances import clearances, sphere_centers_batch
 from ocpkit.problem import Problem
 from ocpkit.robots import sphere_reach
 

@@ -18,7 +18,7 @@ import casadi as ca
 import numpy as np
 
 from ocpkit.constraints.base import Constraint, Context, PointValues, Rows
-from ocpkit.verify import DYNAMICS_TOLERANCE
+from ocpkit.tolerances import DYNAMICS_TOLERANCE
 
 CONSISTENCY_BOUND = DYNAMICS_TOLERANCE / 2
 """|τ − rnea − friction| / (2 τ_max) at a check point: half the verification's tolerance, room for the

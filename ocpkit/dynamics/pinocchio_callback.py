@@ -26,8 +26,8 @@ Solvers that need an exact Hessian (fatrop) or a symbolic graph (pyomo) report t
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np

@@ -13,9 +13,9 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.errors import RobotError, within
+from ocpkit.formats.schema import ROBOT, SPEC, check, read_yaml, show
 from ocpkit.robots.friction import friction_slope, friction_torque
 from ocpkit.robots.urdf import model_from_urdf, resolve_urdf
-from ocpkit.schema import ROBOT, SPEC, check, read_yaml, show
 
 DATA_DIR = Path(__file__).parent / "data"
 
@@ -105,7 +105,7 @@ _BY_KEY: dict[str, Robot] = {}
 
 
 def robot_from_files(urdf: Path, spec_file: Path) -> Robot:
-    """Build a Robot from a URDF and a spec.yaml (README, section 'Robot files'; ocpkit.schema.SPEC).
+    """Build a Robot from a URDF and a spec.yaml (README, section 'Robot files'; ocpkit.formats.schema.SPEC).
 
     Both files are read anew on every call; identical content gives the same Robot object (a bounded cache by
     content key), so problems on one robot share one Robot and its builds, and an edited file a new Robot."""

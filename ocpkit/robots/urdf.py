@@ -14,8 +14,7 @@ from typing import BinaryIO
 import pinocchio as pin
 
 from ocpkit.errors import RobotError
-from ocpkit.schema import one_line
-
+from ocpkit.formats.schema import one_line
 
 EXAMPLE_ROBOT_DATA = "example-robot-data:"
 """Prefix of a spec's `urdf:` naming a file inside the example-robot-data package's share/example-robot-data/."""

@@ -22,7 +22,6 @@ import numpy as np
 from ocpkit.nlp import NLP
 from ocpkit.registry import Registry
 
-
 BOUND_TOLERANCE = 1e-6
 """How far, relative to max(ubx − lbx, 1), a solution may lie outside its variable bounds and count as inside."""
 

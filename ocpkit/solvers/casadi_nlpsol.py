@@ -30,8 +30,15 @@ import numpy as np
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP, Stages
-from ocpkit.solvers.base import (BOUND_TOLERANCE, PreparedSolver, Solver, SolverResult, SolverStatus, bound_slack,
-                                 time_limit)
+from ocpkit.solvers.base import (
+    BOUND_TOLERANCE,
+    PreparedSolver,
+    Solver,
+    SolverResult,
+    SolverStatus,
+    bound_slack,
+    time_limit,
+)
 from ocpkit.solvers.pointwise import pointwise_derivatives
 
 _UNIFIED_STATUS = {

@@ -29,7 +29,7 @@ _spent = 0.0  # seconds this process has spent compiling
 
 
 def compile_seconds() -> float:
-    """Seconds this process has spent compiling so far (the set-up's `compile` part: ocpkit.build_cache)."""
+    """Seconds this process has spent compiling so far (the set-up's `compile` part: ocpkit.planner.build_cache)."""
     return _spent
 
 

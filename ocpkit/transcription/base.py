@@ -21,10 +21,10 @@ from ocpkit.constraints import Constraint
 from ocpkit.constraints.collision import MAX_MARGIN
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import OptionError
+from ocpkit.formats.trajectory import Trajectory
 from ocpkit.nlp import NLP, Refinement
 from ocpkit.problem import Problem
 from ocpkit.registry import Registry
-from ocpkit.trajectory import Trajectory
 from ocpkit.transcription.ocp import OCP
 
 

@@ -22,9 +22,9 @@ import numpy as np
 
 from ocpkit.constraints import Constraint
 from ocpkit.dynamics import Dynamics
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.nlp import Refinement, Stages
 from ocpkit.problem import Problem
-from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription.assembly import Assembly, Node, Slope
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP

@@ -33,10 +33,10 @@ import numpy as np
 import pinocchio as pin
 
 from ocpkit.dynamics import Dynamics
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import DEGREE, PathSpline, symbolic
 from ocpkit.problem import Problem
 from ocpkit.robots import Robot, rigid_torque
-from ocpkit.trajectory import Samples, Trajectory
 
 
 class Node(NamedTuple):

@@ -10,8 +10,8 @@ docs/transcription.md, section "Pseudospectral".
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 

@@ -26,14 +26,13 @@ import numpy as np
 from ocpkit.constraints import Constraint
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import OptionError
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.nlp import Refinement
 from ocpkit.problem import Problem
-from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription.assembly import Assembly, Node, Slope
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP
 from ocpkit.transcription.polynomials import NodeFamily
-
 
 CHECK_PARTS = ("q", "qd", "qdd")
 """The chain parts lifted at the check points (as variables "q_check", "qd_check", "qdd_check" (m, checks)), so

@@ -10,7 +10,7 @@ import numpy as np
 import pinocchio as pin
 import viser
 
-from ocpkit.scene import Workspace
+from ocpkit.geometry.scene import Workspace
 from ocpkit.viewer.motion import (
     OBSTACLE_COLOR,
     ROBOT_COLOR,

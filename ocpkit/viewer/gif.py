@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from ocpkit.scene import Workspace  # noqa: E402
+from ocpkit.geometry.scene import Workspace  # noqa: E402
 from ocpkit.viewer.motion import (  # noqa: E402
     OBSTACLE_COLOR,
     ROBOT_COLOR,

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from ocpkit.errors import OptionError
-from ocpkit.geometry import sphere_centers
+from ocpkit.geometry.clearances import sphere_centers
+from ocpkit.geometry.scene import Scene, Workspace
 from ocpkit.problem import Problem
-from ocpkit.scene import Scene, Workspace
 
 ROBOT_COLOR = (235, 110, 20)
 """RGB of the robot's spheres (orange: the viewer test looks for it)."""

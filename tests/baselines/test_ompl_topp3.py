@@ -17,10 +17,10 @@ from numpy.polynomial import Polynomial
 import ocpkit
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
+from ocpkit.formats.record import trajectory_header
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import DEGREE, PathSpline, symbolic
-from ocpkit.report import trajectory_header
 from ocpkit.robots import rigid_torque
-from ocpkit.trajectory import Samples, Trajectory
 from ocpkit.transcription import TRANSCRIPTIONS
 from ocpkit.transcription.ocp import Node, PathTimingOCP, Slope
 
@@ -256,7 +256,7 @@ def test_retiming_the_simultaneous_plans_own_path_reproduces_its_motion_time(cas
     """Two OCP families, one answer: the simultaneous plan's path (a natural quintic through 25 of its samples),
     timed by the path-timing OCP with the same limits and cost, takes the simultaneous plan's t_f within 1 %."""
     from ocpkit.baselines.ompl_topp3 import time_path
-    from ocpkit.ladder import SINGLE_SHOT
+    from ocpkit.planner.ladder import SINGLE_SHOT
 
     problem = ocpkit.load_scenario(REPO / f"scenarios/paper/{case}.yaml")
     simultaneous = ocpkit.plan(problem, fallbacks=SINGLE_SHOT)

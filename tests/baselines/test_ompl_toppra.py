@@ -13,11 +13,20 @@ from helpers import REPO, discretize
 
 import ocpkit
 import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
-from ocpkit.baselines.ompl_toppra import (GUESS_SLOWDOWN, MAX_STEP, FreeSpace, _planner, _space_information, _state,
-                                         ompl_guess, plan_ompl_toppra, planning_space)
+from ocpkit.baselines.ompl_toppra import (
+    GUESS_SLOWDOWN,
+    MAX_STEP,
+    FreeSpace,
+    _planner,
+    _space_information,
+    _state,
+    ompl_guess,
+    plan_ompl_toppra,
+    planning_space,
+)
 from ocpkit.errors import OptionError, RegistryError, ScenarioError
-from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.verify import GEOMETRY_TOLERANCE
+from ocpkit.geometry.clearances import clearances, sphere_centers
+from ocpkit.tolerances import GEOMETRY_TOLERANCE
 
 
 @pytest.fixture(scope="module")

@@ -10,9 +10,9 @@ import pytest
 from helpers import REPO
 
 from ocpkit.bench.solvers import combinations, run_solver_benchmark
-from ocpkit.cli import main
+from ocpkit.cli.main import main
 from ocpkit.dynamics import DYNAMICS
-from ocpkit.report import RESULT_COLUMNS
+from ocpkit.formats.record import RESULT_COLUMNS
 from ocpkit.solvers import SOLVERS
 
 

@@ -6,9 +6,14 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from ocpkit.bench.metrics import end_effector_positions, plan_metrics, success_grid, summarize
+from ocpkit.bench.metrics import (
+    end_effector_positions,
+    plan_metrics,
+    success_grid,
+    summarize,
+)
+from ocpkit.formats.trajectory import Samples
 from ocpkit.robots import load_robot
-from ocpkit.trajectory import Samples
 
 
 def samples_of(q: np.ndarray, tau: np.ndarray, dt: float = 1e-3) -> Samples:

@@ -8,10 +8,19 @@ import numpy as np
 import pytest
 from helpers import REPO
 
-from ocpkit.bench.perf import (EVALUATIONS, PARTS, cluttered, cold_compile, fitted_exponent, ipopt_timing,
-                               linear_share, planned, run_perf)
-from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.scenario import load_scenario
+from ocpkit.bench.perf import (
+    EVALUATIONS,
+    PARTS,
+    cluttered,
+    cold_compile,
+    fitted_exponent,
+    ipopt_timing,
+    linear_share,
+    planned,
+    run_perf,
+)
+from ocpkit.formats.scenario import load_scenario
+from ocpkit.geometry.clearances import clearances, sphere_centers
 from ocpkit.solvers.compiled import compiler
 
 CASE2 = load_scenario(REPO / "scenarios/paper/case2.yaml")

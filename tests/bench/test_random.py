@@ -9,7 +9,7 @@ import pytest
 
 from ocpkit.bench import random as suite
 from ocpkit.bench.random import PATH_SPHERES, RADII, random_problems
-from ocpkit.geometry import clearances, sphere_centers
+from ocpkit.geometry.clearances import clearances, sphere_centers
 
 
 def test_the_original_suite_keeps_its_problems():

@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from helpers import REPO
 from PIL import Image
+from viewer_helpers import chromium
 
 from ocpkit.bench.run import run_suite
-from ocpkit.cli import main
-from viewer_helpers import chromium
+from ocpkit.cli.main import main
 
 SUITE = f"""name: small
 scenarios:

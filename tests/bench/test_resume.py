@@ -15,7 +15,7 @@ import pytest
 from helpers import REPO
 
 from ocpkit.bench.common import Results
-from ocpkit.report import KEY_COLUMNS, RESULT_COLUMNS, row_key
+from ocpkit.formats.record import KEY_COLUMNS, RESULT_COLUMNS, row_key
 
 ROW = {**dict.fromkeys(RESULT_COLUMNS, ""), "suite": "paper", "case": "case1", "planner": "simultaneous",
        "knots": 12, "status": "verified", "tf": 1.5, "extra": "{}"}
@@ -56,7 +56,7 @@ def test_ctrl_c_keeps_finished_rows_and_a_rerun_completes_each_row_once(tmp_path
     cases.mkdir()
     shutil.copy(REPO / "scenarios/paper/case4.yaml", cases)
     out = tmp_path / "out"
-    command = [sys.executable, "-m", "ocpkit.cli", "bench", "paper", "--repeats", "1", "--scenarios", str(cases),
+    command = [sys.executable, "-m", "ocpkit.cli.main", "bench", "paper", "--repeats", "1", "--scenarios", str(cases),
                "--hard", "", "--out", str(out)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     while process.poll() is None and len(_rows_if_any(out / "results.csv")) < 1:

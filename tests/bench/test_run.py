@@ -15,10 +15,10 @@ from pathlib import Path
 import pytest
 from helpers import REPO
 
-from ocpkit.bench.run import run_suite
 from ocpkit.bench import suite as suite_module
+from ocpkit.bench.run import run_suite
 from ocpkit.bench.suite import SuiteError, load_suite
-from ocpkit.cli import main
+from ocpkit.cli.main import main
 
 TIMINGS = ("solve_time_s", "setup_time_s", "wall_time_s", "extra")  # extra holds the baseline's stage times
 SUITE = f"""name: small
@@ -89,7 +89,7 @@ def test_an_unreachable_scheduler_is_one_error_line(tmp_path, capsys, monkeypatc
 
 def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uninterrupted_run(tmp_path):
     suite, out = write_suite(tmp_path, repeats=3), tmp_path / "out"
-    command = [sys.executable, "-m", "ocpkit.cli", "bench", "run", str(suite), "--out", str(out), "--jobs", "2"]
+    command = [sys.executable, "-m", "ocpkit.cli.main", "bench", "run", str(suite), "--out", str(out), "--jobs", "2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     results = out / "results.csv"
     while process.poll() is None and not (results.exists() and len(read_rows(results)) >= 2):
@@ -234,7 +234,7 @@ def test_the_paper_suite_gives_the_same_rows_with_jobs_2_on_a_local_cluster_and_
     assert main(["bench", "run", str(suite), "--out", str(tmp_path / "jobs"), "--jobs", "2"]) == 0
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         run_suite(suite, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False)
-    command = [sys.executable, "-m", "ocpkit.cli", "bench", "run", str(suite), "--out", str(tmp_path / "cut"),
+    command = [sys.executable, "-m", "ocpkit.cli.main", "bench", "run", str(suite), "--out", str(tmp_path / "cut"),
                "--jobs", "2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     results = tmp_path / "cut" / "results.csv"

@@ -12,11 +12,11 @@ from helpers import REPO
 import ocpkit
 from ocpkit.constraints import Context, PointValues
 from ocpkit.constraints.collision import MAX_MARGIN, SphereCollision, active_terms
-from ocpkit.distance import box_distance, cylinder_distance
-from ocpkit.quaternion import quaternion_matrix
 from ocpkit.dynamics import make_dynamics
-from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.scene import Boxes, Cylinders, Scene, Workspace
+from ocpkit.geometry.clearances import clearances, sphere_centers
+from ocpkit.geometry.distance import box_distance, cylinder_distance
+from ocpkit.geometry.quaternion import quaternion_matrix
+from ocpkit.geometry.scene import Boxes, Cylinders, Scene, Workspace
 
 PROBLEM = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
 ROBOT = PROBLEM.robot

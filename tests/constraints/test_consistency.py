@@ -12,7 +12,7 @@ import ocpkit
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Context, PointValues
 from ocpkit.constraints.consistency import CONSISTENCY_BOUND, DynamicsConsistency
 from ocpkit.dynamics import make_dynamics
-from ocpkit.verify import DYNAMICS_TOLERANCE
+from ocpkit.tolerances import DYNAMICS_TOLERANCE
 
 PROBLEM = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
 ROBOT = PROBLEM.robot

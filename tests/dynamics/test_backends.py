@@ -10,7 +10,7 @@ import pytest
 from ocpkit import load_robot
 from ocpkit.dynamics import DYNAMICS, make_dynamics
 from ocpkit.errors import OptionError, RegistryError
-from ocpkit.geometry import sphere_centers
+from ocpkit.geometry.clearances import sphere_centers
 
 ROBOT = load_robot("industrial6")
 RNG = np.random.default_rng(3)

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-
 import casadi as ca
 import numpy as np
 import pinocchio as pin
 import pytest
-
 from helpers import REPO, example_robot_urdf
 
 from ocpkit.dynamics.spatial import SymbolicModel

@@ -11,8 +11,8 @@ import pytest
 from helpers import REPO
 
 import ocpkit
-from ocpkit.geometry import clearances, sphere_centers
-from ocpkit.report import trajectory_header
+from ocpkit.formats.record import trajectory_header
+from ocpkit.geometry.clearances import clearances, sphere_centers
 
 BOXES = REPO / "scenarios/shapes/boxes.yaml"
 DATA = REPO / "ocpkit/robots/data/industrial6"

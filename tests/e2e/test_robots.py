@@ -13,7 +13,7 @@ import pytest
 import yaml
 from helpers import REPO
 
-from ocpkit.cli import main
+from ocpkit.cli.main import main
 from ocpkit.robots.robot import DATA_DIR
 
 VAMP = REPO / "tests/robots/vamp"

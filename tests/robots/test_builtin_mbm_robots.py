@@ -12,10 +12,10 @@ import pytest
 
 from ocpkit import load_robot
 from ocpkit.dynamics import make_dynamics
-from ocpkit.geometry import collision_report, sphere_centers
+from ocpkit.geometry.clearances import collision_report, sphere_centers
+from ocpkit.geometry.scene import Scene
 from ocpkit.robots.spheres import urdf_spheres
 from ocpkit.robots.urdf import example_robot_data_dir
-from ocpkit.scene import Scene
 
 VAMP = Path(__file__).parent / "vamp"
 RNG = np.random.default_rng(12)

@@ -11,9 +11,9 @@ import pinocchio as pin
 import pytest
 import yaml
 
-from ocpkit.cli import main
+from ocpkit.cli.main import main
 from ocpkit.errors import RobotError
-from ocpkit.geometry import sphere_centers
+from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.robots import load_robot
 from ocpkit.robots.importer import MOTOR_SPEED, TORQUE_RATE_PER_SECOND
 

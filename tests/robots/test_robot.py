@@ -13,7 +13,7 @@ from helpers import REPO, example_robot_urdf
 
 from ocpkit import load_robot
 from ocpkit.errors import RobotError
-from ocpkit.geometry import sphere_centers
+from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.robots import builtin_robots, rigid_torque, sphere_reach
 
 SPEC = REPO / "ocpkit/robots/data/industrial6/spec.yaml"

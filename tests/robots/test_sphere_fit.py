@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from ocpkit.cli import main
+from ocpkit.cli.main import main
 from ocpkit.robots.link_geometry import link_meshes
 from ocpkit.robots.sphere_fit import fit_spheres, inside_mesh, quality
 from ocpkit.robots.urdf import example_robot_data_dir

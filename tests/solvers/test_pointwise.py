@@ -16,8 +16,8 @@ import ocpkit.solvers.compiled as compiled_module
 from ocpkit import load_scenario
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
+from ocpkit.geometry.scene import Boxes, Cylinders
 from ocpkit.path_spline import PathSpline
-from ocpkit.scene import Boxes, Cylinders
 from ocpkit.solvers.pointwise import pointwise_derivatives
 from ocpkit.transcription import TRANSCRIPTIONS
 from ocpkit.transcription.ocp import PathTimingOCP

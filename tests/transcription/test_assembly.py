@@ -12,7 +12,7 @@ from helpers import REPO
 from ocpkit import load_scenario
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
-from ocpkit.scene import Boxes, Cylinders
+from ocpkit.geometry.scene import Boxes, Cylinders
 from ocpkit.transcription.assembly import Assembly, Slope
 
 CASE = load_scenario(REPO / "scenarios/paper/case1.yaml")

@@ -8,8 +8,7 @@ import dataclasses
 import casadi as ca
 import numpy as np
 import pytest
-from helpers import REPO, discretize, evaluate
-from test_verify import quintic
+from helpers import REPO, discretize, evaluate, quintic
 
 from ocpkit import load_scenario
 from ocpkit.constraints import make_constraints

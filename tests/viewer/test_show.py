@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 from helpers import REPO
 from PIL import Image, ImageSequence
+from viewer_helpers import chromium, free_port
 
 from ocpkit import load_scenario, plan
-from ocpkit.cli import main
-from ocpkit.report import trajectory_header
-from ocpkit.trajectory import write_json
-from viewer_helpers import chromium, free_port
+from ocpkit.cli.main import main
+from ocpkit.formats.record import trajectory_header
+from ocpkit.formats.trajectory import write_json
 
 SCENARIO = REPO / "scenarios/paper/case2.yaml"
 
@@ -39,7 +39,7 @@ def robot_pixels(image: Image.Image) -> int:
 
 def test_the_browser_viewer_shows_the_robot(trajectory, tmp_path):
     port = free_port()
-    viewer = subprocess.Popen([sys.executable, "-m", "ocpkit.cli", "show", str(trajectory), "--scenario",
+    viewer = subprocess.Popen([sys.executable, "-m", "ocpkit.cli.main", "show", str(trajectory), "--scenario",
                                str(SCENARIO), "--port", str(port)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         deadline = time.monotonic() + 60

@@ -1,0 +1,181 @@
+"""The MotionBenchMaker problems (Chamzas et al. 2022) as scenario files, from the vamp-planner source distribution.
+
+`fetch_mbm(robot, directory)` downloads the `vamp-planner` sdist with pip (`pip download --no-deps --no-binary
+vamp-planner`: the .tar.gz itself, nothing is built; pip only prepares its metadata), takes
+resources/<robot>/problems.tar.bz2 and vamp's LICENSE out of it with tarfile, unpacks the MoveIt YAML pairs
+(problems/<scene>_<robot>/sceneNNNN.yaml + requestNNNN.yaml) and converts each pair with `ocpkit.formats.moveit` to
+DIR/<robot>/<scene>/NNNN.yaml. Every step is skipped when its result is already in DIR, so a second run only
+checks. Layout of DIR (default ~/.cache/ocpkit/mbm, or $XDG_CACHE_HOME/ocpkit/mbm):
+
+    vamp_planner-VERSION.tar.gz        the sdist, as downloaded
+    LICENSE-vamp.txt                   vamp's Apache-2.0 licence (it covers the problem files)
+    <robot>/moveit/problems/...        the MoveIt YAML pairs, as shipped
+    <robot>/<scene>/NNNN.yaml          the scenarios
+    <robot>/invalid.txt                problems ocpkit's model of the robot rejects, with the reason
+
+MBM scenes have no workspace box: their tables, shelves and cages are obstacles, and MoveIt's
+`workspace_parameters` bound a mobile base's virtual joint, not the arm.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tarfile
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from tqdm import tqdm
+
+from ocpkit.errors import OcpkitError, RobotError
+from ocpkit.formats.moveit import read_moveit, resolve_robot, scenario_text
+from ocpkit.formats.scenario import load_scenario
+from ocpkit.formats.schema import one_line
+
+VAMP_VERSION = "0.6.4"
+"""The vamp-planner release whose problems.tar.bz2 files are read (pinned: the same problems on every machine)."""
+SCENES = ("table_pick", "table_under_pick", "box", "bookshelf_small", "bookshelf_tall", "bookshelf_thin", "cage")
+ROBOTS = ("panda", "ur5", "fetch")
+MBM_JOINTS = {
+    "panda": [f"panda_joint{i}" for i in range(1, 8)],
+    "ur5": ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
+            "wrist_3_joint"],
+    "fetch": ["torso_lift_joint", "shoulder_pan_joint", "shoulder_lift_joint", "upperarm_roll_joint",
+              "elbow_flex_joint", "forearm_roll_joint", "wrist_flex_joint", "wrist_roll_joint"],
+}
+"""The planned joints of each MBM robot in MoveIt's group order, for when ocpkit has no such built-in robot."""
+NOTICE = ("MotionBenchMaker problem from vamp-planner {version} (resources/{robot}/problems.tar.bz2; Apache License "
+          "2.0, see LICENSE-vamp.txt),",
+          "modified: converted from MoveIt YAML to an ocpkit scenario by `ocpkit data mbm`.")
+"""The licence notice at the top of every converted file (format with version and robot)."""
+
+
+class DataError(OcpkitError):
+    """A data set cannot be obtained or unpacked."""
+
+
+@dataclass(frozen=True)
+class MbmSummary:
+    """What `fetch_mbm` did: scenario files written now, found already there, and problems rejected by ocpkit's
+    model of the robot (None: the robot is not built in here, nothing was validated)."""
+
+    directory: Path
+    written: int
+    kept: int
+    invalid: int | None
+
+
+def default_directory() -> Path:
+    """~/.cache/ocpkit/mbm, or $XDG_CACHE_HOME/ocpkit/mbm."""
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "ocpkit" / "mbm"
+
+
+def fetch_mbm(robot: str, directory: Path | None = None, progress: bool = True) -> MbmSummary:
+    """Download (once), unpack (once) and convert (each missing file) the 700 MBM problems of `robot`."""
+    if robot not in ROBOTS:
+        raise DataError(f"unknown MBM robot {robot!r}; choose one of {', '.join(ROBOTS)}")
+    directory = Path(directory or default_directory()).expanduser()
+    try:
+        sdist = download_vamp(directory)
+        problems = unpack_problems(sdist, robot, directory)
+        return convert_problems(robot, problems, directory / robot, progress)
+    except OSError as exc:  # a folder that cannot be written, a full disk
+        raise DataError(f"cannot write the MBM cache: {exc.filename or directory}: {exc.strerror}") from exc
+
+
+def download_vamp(directory: Path) -> Path:
+    """The vamp-planner sdist in `directory`, downloaded with pip unless it is already there."""
+    target = directory / f"vamp_planner-{VAMP_VERSION}.tar.gz"
+    if target.is_file():
+        return target
+    directory.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=directory) as scratch:
+        print(f"downloading the vamp-planner {VAMP_VERSION} source distribution (about 65 MB) with pip ...",
+              file=sys.stderr)
+        command = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", "vamp-planner",
+                   f"vamp-planner=={VAMP_VERSION}", "-d", scratch, "--quiet"]
+        done = subprocess.run(command, capture_output=True, text=True)
+        found = list(Path(scratch).glob("vamp_planner-*.tar.gz"))
+        if done.returncode != 0 or not found:
+            tail = " ".join((done.stderr or done.stdout).strip().splitlines()[-3:])
+            raise DataError(f"pip could not download vamp-planner {VAMP_VERSION}: {tail or 'no sdist found'}")
+        shutil.move(found[0], target)
+    return target
+
+
+def unpack_problems(sdist: Path, robot: str, directory: Path) -> Path:
+    """The folder of `robot`'s MoveIt problem pairs, unpacked from the sdist unless already there; vamp's licence
+    is copied beside them."""
+    moveit = directory / robot / "moveit"
+    done = moveit / ".complete"
+    if done.is_file():
+        return moveit / "problems"
+    inner = f"resources/{robot}/problems.tar.bz2"
+    try:
+        with tarfile.open(sdist) as outer:
+            members = {Path(*Path(m.name).parts[1:]).as_posix(): m for m in outer.getmembers() if m.isfile()}
+            if inner not in members or "LICENSE.txt" not in members:
+                raise DataError(f"{sdist} has no {inner} or LICENSE.txt: not a vamp-planner sdist?")
+            (directory / "LICENSE-vamp.txt").write_bytes(outer.extractfile(members["LICENSE.txt"]).read())
+            with tarfile.open(fileobj=outer.extractfile(members[inner]), mode="r:bz2") as problems:
+                _extract(problems, moveit)
+    except (tarfile.TarError, OSError, EOFError) as exc:
+        raise DataError(f"cannot unpack {inner} from {sdist}: {one_line(str(exc))} (delete the file to download it "
+                        "again)") from exc
+    done.touch()
+    return moveit / "problems"
+
+
+def _extract(archive: tarfile.TarFile, target: Path) -> None:
+    """Extract the regular files of `archive` below `target`, refusing any path that leaves it."""
+    target.mkdir(parents=True, exist_ok=True)
+    root = target.resolve()
+    for member in archive.getmembers():
+        path = (target / member.name).resolve()
+        if not path.is_relative_to(root):
+            raise DataError(f"refusing the archive member {member.name!r}: outside {target}")
+        if member.isfile():
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(archive.extractfile(member).read())
+
+
+def convert_problems(robot: str, problems: Path, out: Path, progress: bool = True) -> MbmSummary:
+    """Convert every problems/<scene>_<robot>/sceneNNNN.yaml + requestNNNN.yaml to out/<scene>/NNNN.yaml (files
+    already there are kept) and, when ocpkit has `robot` built in, load each (validation) and list the rejected
+    ones in out/invalid.txt."""
+    pairs = sorted((scene, request) for scene in SCENES
+                   for request in (problems / f"{scene}_{robot}").glob("request*.yaml"))
+    if not pairs:
+        raise DataError(f"no MBM problems under {problems}")
+    written = kept = 0
+    rejected: list[str] = []
+    try:
+        field, joints, loaded = resolve_robot(robot, out)
+    except RobotError:  # not built in here: the MBM joint order, no validation
+        field, joints, loaded = robot, MBM_JOINTS[robot], None
+    for scene, request in tqdm(pairs, desc=f"MBM {robot}", unit="problem", disable=not progress):
+        number = request.stem.removeprefix("request")
+        target = out / scene / f"{number}.yaml"
+        if target.is_file():
+            kept += 1
+        else:
+            conversion = read_moveit(request.with_name(f"scene{number}.yaml"), request, joints, field,
+                                     f"{scene}_{number}")
+            target.parent.mkdir(parents=True, exist_ok=True)
+            source = f"{robot}/moveit/problems/{scene}_{robot}/{{scene,request}}{number}.yaml"
+            notice = [line.format(version=VAMP_VERSION, robot=robot) for line in NOTICE]
+            partial = target.with_suffix(".part")  # renamed when complete: an interrupted run leaves no half file
+            partial.write_text(scenario_text(conversion, [*notice, f"Source: {source}"]))
+            partial.replace(target)
+            written += 1
+        if loaded is not None:
+            try:
+                load_scenario(target)
+            except OcpkitError as exc:
+                rejected.append(f"{exc}")
+    if loaded is not None:
+        (out / "invalid.txt").write_text("".join(f"{line}\n" for line in rejected))
+    return MbmSummary(out, written, kept, len(rejected) if loaded is not None else None)

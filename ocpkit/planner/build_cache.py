@@ -1,0 +1,98 @@
+"""The build cache: one Discretization and prepared solver per problem shape, shared by every query of it.
+
+`build(problem, ...)` returns the Discretization of the problem's shape and a solver prepared for its NLP,
+building both on first use. The key is the transcription's options, the dynamics backend (its robot's content
+included), each constraint's shape, the solver and its options: start, goal, time bounds, μ and obstacle
+positions are numbers, so queries that differ only in them share a build. The cache holds the most recently used
+`CACHE_SIZE` builds.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import OrderedDict
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
+from ocpkit.dynamics import Dynamics, make_dynamics
+from ocpkit.errors import OptionError
+from ocpkit.planner.screening import SCREEN_DISTANCE
+from ocpkit.problem import Problem
+from ocpkit.solvers import SOLVERS, PreparedSolver
+from ocpkit.solvers.compiled import compile_seconds
+from ocpkit.transcription import TRANSCRIPTIONS, Discretization
+from ocpkit.transcription.ocp import OCP
+
+CACHE_SIZE = 8  # builds; one of a 7-joint MBM problem holds 350–450 MB
+
+
+@dataclass(frozen=True)
+class Build:
+    """A Discretization, a solver prepared for its NLP, the seconds its set-up took (0 when it came from the
+    cache) and their split: `setup_parts` {"graph": the transcription's build, "solver": the solver's prepare,
+    "compile": the part of it spent compiling C (ocpkit.solvers.compiled; 0 when the disk cache had it)}
+    (s, empty when cached)."""
+
+    discretization: Discretization
+    solver: PreparedSolver
+    setup_time: float
+    setup_parts: dict = field(default_factory=dict)
+
+
+_BUILDS: OrderedDict[tuple, Build] = OrderedDict()
+
+
+def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str | Dynamics = "casadi-rnea",
+          solver: str = "ipopt", constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
+          transcription_options: dict | None = None, solver_options: dict | None = None,
+          dynamics_options: dict | None = None, ocp: OCP | None = None, near: np.ndarray | None = None) -> Build:
+    """The build for `problem`'s shape (module docstring): components by registered name (`ocpkit list`), a
+    dynamics backend also as an instance; unknown options raise OptionError. `ocp` is the OCP to discretize:
+    the robot OCP of `problem` by default (ocpkit.transcription.ocp). With `near` (K, n), the constraints keep only
+    the rows that can be active near those configurations (ocpkit.planner.screening)."""
+    method = construct(TRANSCRIPTIONS.get(transcription), transcription, {"knots": knots,
+                                                                          **(transcription_options or {})})
+    backend = make_dynamics(dynamics, problem.robot, **(dynamics_options or {}))
+    plugins = make_constraints(problem, constraints, None if near is None else (near, SCREEN_DISTANCE))
+    options = solver_options or {}
+    nlp_solver = construct(SOLVERS.get(solver), solver, options)  # a wrong name or option fails before a build
+    key = (method.shape_key(backend, plugins, ocp), solver, frozen(options))
+    if key in _BUILDS:
+        _BUILDS.move_to_end(key)
+        return Build(_BUILDS[key].discretization, _BUILDS[key].solver, 0.0)
+    began = time.perf_counter()
+    discretization = method.build(problem, backend, plugins, ocp)
+    built, compiling = time.perf_counter(), compile_seconds()
+    prepared = nlp_solver.prepare(discretization.nlp)
+    ended, compiled = time.perf_counter(), compile_seconds() - compiling
+    _BUILDS[key] = Build(discretization, prepared, ended - began,
+                         {"graph": built - began, "solver": ended - built - compiled, "compile": compiled})
+    while len(_BUILDS) > CACHE_SIZE:
+        _BUILDS.popitem(last=False)
+    return _BUILDS[key]
+
+
+def clear_builds() -> None:
+    """Forget every cached build."""
+    _BUILDS.clear()
+
+
+def frozen(value: Any) -> Any:
+    """`value` made hashable for a cache key: mappings as sorted (key, value) tuples, sequences as tuples."""
+    if isinstance(value, dict):
+        return tuple(sorted((key, frozen(item)) for key, item in value.items()))
+    if isinstance(value, (list, tuple)):
+        return tuple(frozen(item) for item in value)
+    return value
+
+
+def construct(component: Callable, name: str, options: dict) -> Any:
+    """`component(**options)`; an option it does not take is the user's mistake, reported as an OptionError."""
+    try:
+        return component(**options)
+    except TypeError as exc:
+        raise OptionError(f"{name}: {exc} (options given: {sorted(options)})") from exc

@@ -1,0 +1,55 @@
+"""Active-set screening of the collision rows: the NLP carries only the terms that can matter near the motion.
+
+A 7-joint arm of 60 spheres among a dozen boxes has about 1100 collision terms per point (MotionBenchMaker's
+Panda: 690 sphere pairs of its own and 400 sphere-obstacle terms within reach), most of them far from contact on
+any motion the solver will consider; IPOPT's linear solves grow with every row. So the planner builds the NLP
+with the terms whose clearance is below SCREEN_DISTANCE somewhere along the straight line and along the initial
+guess (`Constraint.screened`), solves, and — verification always checks every term densely — keeps a verified plan
+as it is. An unverified plan whose motion comes within MISSING_DISTANCE of a term left out is solved again,
+warm-started, with the terms near it added (a rebuild, part of the computation time), at most MAX_REBUILDS times;
+such a motion also ends the refinement rounds at once (ocpkit.planner.refinement), since rounds on an NLP without those rows
+cannot fix it (before, a capped rung spent its iterations on them and ended `violated`, the rows still missing).
+Every robot and scene with collision terms screens, the paper's robot (75 terms per point) too: its paper cases keep
+few of them, and IPOPT's linear solves shrink with the rows (figures: docs/design-notes.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ocpkit.constraints import Constraint
+from ocpkit.formats.trajectory import Trajectory
+from ocpkit.problem import Problem
+
+SCREEN_DISTANCE = 0.2  # m: a term is kept when its clearance is below this somewhere near the motion
+MISSING_DISTANCE = 0.1  # m: a left-out term this close to an unverified plan's motion triggers a rebuild
+MAX_REBUILDS = 3
+SAMPLES = 64  # configurations sampled along a motion (evenly in time)
+
+
+def screenable_rows(constraints: Sequence[Constraint]) -> int:
+    """The rows per point of `constraints` that screening may leave out (`Constraint.term_count`)."""
+    return sum(c.term_count for c in constraints)
+
+
+def worth_screening(constraints: Sequence[Constraint]) -> bool:
+    """Whether the constraints have any screenable terms (collision terms) at all."""
+    return screenable_rows(constraints) > 0
+
+
+def line_samples(problem: Problem) -> np.ndarray:
+    """SAMPLES configurations (SAMPLES, n) evenly along the straight joint-space line from start to goal."""
+    return problem.start + np.outer(np.linspace(0.0, 1.0, SAMPLES), problem.goal - problem.start)
+
+
+def motion_samples(trajectory: Trajectory) -> np.ndarray:
+    """SAMPLES configurations (SAMPLES, n) of the motion, evenly in time."""
+    return trajectory.interpolant(np.linspace(0.0, trajectory.tf, SAMPLES)).q
+
+
+def missing(problem: Problem, constraints: Sequence[Constraint], near: np.ndarray) -> int:
+    """Terms left out of `constraints` that come within MISSING_DISTANCE of contact in `problem` at the
+    configurations `near` (K, n)."""
+    return sum(c.missing(problem, near, MISSING_DISTANCE) for c in constraints)

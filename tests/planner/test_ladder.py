@@ -1,0 +1,302 @@
+"""Issue 11: the fallback ladder — rung order, first verified wins, best-of on failure, the shared time budget,
+rung overrides, OMPL rungs without a path, and the single shot of the paper."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from helpers import REPO
+
+import ocpkit
+from ocpkit.baselines.ompl_toppra import ompl_guess
+from ocpkit.bench import paper
+from ocpkit.bench import random as random_suite
+from ocpkit.bench.common import Results
+from ocpkit.cli.main import _planner_options, parser
+from ocpkit.errors import NoGuess, OptionError
+from ocpkit.formats.trajectory import Trajectory
+from ocpkit.planner import GUESSES
+from ocpkit.planner.ladder import (
+    DEFAULT_LADDER,
+    FINER_ITERATIONS,
+    NO_PATH_HINT,
+    OMPL_CHECKS,
+    SINGLE_SHOT,
+    Rung,
+    climb,
+    finer,
+    rank,
+)
+from ocpkit.planner.simultaneous import _capped, _overridden, plan_simultaneous
+from ocpkit.result import Plan, PlanStats
+from ocpkit.verify import Check, Verification
+
+CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
+
+
+def fake(status: str, worst: float = 0.0, seconds: float = 1.0, iterations: int = 10, check: str = "obstacle",
+         trajectory: object = None) -> Plan:
+    """A plan with `status`, one `check` of `worst` (failed if > 0; at t = 0.5 s a path violation a refinement
+    round can fix unless the check is "dynamics"), `seconds` of computation."""
+    times = np.array([0.5]) if worst > 0 and check != "dynamics" else np.zeros(0)
+    verification = Verification((Check(check, worst, 0.0, 0.5, "m"),), times)
+    stats = PlanStats(seconds, 0.5, iterations, 1, f"{status} message", {"own": 1})
+    return Plan(trajectory, status, verification, stats, {"planner": "fake"})
+
+
+class Script:
+    """An attempt function that returns the scripted plan of each rung and records (rung name, seconds left)."""
+
+    def __init__(self, plans: dict[str, Plan]) -> None:
+        self.plans, self.calls = plans, []
+
+    def __call__(self, rung: Rung | None, left: float) -> Plan:
+        self.calls.append((rung.name if rung else None, left))
+        return self.plans[rung.name if rung else "none"]
+
+
+LADDER = (Rung("a"), Rung("b", guess="ompl", seed=1), Rung("c", knots=16))
+
+
+def test_the_first_verified_rung_wins_and_later_rungs_do_not_run():
+    script = Script({"a": fake("infeasible", seconds=2.0), "b": fake("verified"), "c": fake("verified")})
+    result = climb(script, LADDER, 60.0)
+    assert [name for name, _ in script.calls] == ["a", "b"]
+    assert result.ok and result.method["rung"] == "b"
+    assert result.stats.extra["rungs"] == [{"rung": "a", "status": "infeasible", "time_s": 2.0, "iterations": 10},
+                                           {"rung": "b", "status": "verified", "time_s": 1.0, "iterations": 10}]
+    assert (result.stats.solve_time, result.stats.setup_time, result.stats.iterations) == (3.0, 1.0, 20)
+
+
+def test_without_a_verified_rung_the_smallest_violation_is_the_best():
+    script = Script({"a": fake("violated", 0.02), "b": fake("infeasible"), "c": fake("violated", 0.005)})
+    result = climb(script, LADDER, 60.0)
+    assert result.status == "violated" and result.method["rung"] == "c"
+    assert result.stats.solver_message == "rung c: violated message"
+    extra = result.stats.extra
+    assert extra["own"] == 1 and len(extra["rungs"]) == 3 and extra["skipped"] == []
+
+
+@pytest.mark.parametrize("statuses, best", [(("time_limit", "infeasible", "iteration_limit"), "infeasible"),
+                                            (("failed", "iteration_limit", "time_limit"), "iteration_limit")])
+def test_a_failure_reports_the_best_rungs_status(statuses, best):
+    script = Script({rung.name: fake(status) for rung, status in zip(LADDER, statuses)})
+    assert climb(script, LADDER, 60.0).status == best
+
+
+def test_rank_orders_by_status_then_violation():
+    plans = [fake("time_limit"), fake("violated", 0.3), fake("verified"), fake("infeasible"), fake("violated", 0.1)]
+    assert [(p.status, p.verification.checks[0].worst) for p in sorted(plans, key=rank)] == [
+        ("verified", 0.0), ("violated", 0.1), ("violated", 0.3), ("infeasible", 0.0), ("time_limit", 0.0)]
+
+
+def test_every_rung_gets_the_time_left_and_none_starts_after_the_budget():
+    script = Script({"a": fake("infeasible", seconds=5.0), "b": fake("iteration_limit", seconds=4.0),
+                     "c": fake("verified")})
+    result = climb(script, LADDER, 8.0)
+    assert script.calls == [("a", 8.0), ("b", 3.0)]
+    assert result.status == "infeasible" and result.method["rung"] == "a"
+
+
+def test_an_empty_ladder_is_one_attempt_with_the_calls_options():
+    plan = fake("violated", 0.1)
+    script = Script({"none": plan})
+    assert climb(script, SINGLE_SHOT, 7.0) is plan and script.calls == [(None, 7.0)]
+
+
+def test_a_rung_overrides_only_what_it_names():
+    options = {"guess": "line", "guess_options": {"planning_time": 2.0}, "knots": 12, "transcription": "chebyshev",
+               "transcription_options": {"staged": False}, "solver_options": {"tol": 1e-7}}
+    changed = _overridden(options, Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300), 9.0)
+    assert changed == {"guess": "ompl", "guess_options": {"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
+                                                          "planning_time": 9.0}, "knots": 16,
+                       "transcription": "chebyshev", "transcription_options": {"staged": False, "segments": 2},
+                       "solver_options": {"tol": 1e-7, "max_iterations": 300}, "iteration_budget": 300}
+    assert options["knots"] == 12 and options["solver_options"] == {"tol": 1e-7}
+    assert _overridden(options, Rung("same"), 9.0) == options and _overridden(options, None, 9.0) is options
+    line = _overridden(options, Rung("line", guess="line"), 9.0)
+    assert line["guess_options"] == {"fallback": False}
+    capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300), 9.0)
+    assert capped["solver_options"] == {"max_iterations": 50} and "iteration_budget" not in capped
+
+
+def test_a_rebuild_solves_within_what_is_left_of_the_rungs_iteration_budget():
+    options = {"guess": "line", "solver_options": {"tol": 1e-7, "max_iterations": 300}}
+    assert _capped(options, 120.0)["solver_options"] == {"tol": 1e-7, "max_iterations": 120}
+    assert _capped(options, 500.0)["solver_options"]["max_iterations"] == 300
+    assert _capped({**options, "solver_options": {}}, 40.0)["solver_options"] == {"max_iterations": 40}
+    assert _capped(options, math.inf) is options and options["solver_options"]["max_iterations"] == 300
+
+
+def test_a_transcription_without_segments_keeps_the_calls_grid_on_a_rung_with_segments():
+    options = {"guess": "line", "guess_options": {}, "knots": 40, "transcription": "trapezoidal",
+               "transcription_options": {}}
+    changed = _overridden(options, Rung("x", guess="ompl", knots=6, segments=3), 9.0)
+    assert changed["knots"] == 40 and changed["transcription_options"] == {} and changed["guess"] == "ompl"
+    assert _overridden(options, Rung("y", knots=16), 9.0)["knots"] == 16
+
+
+def test_without_a_wall_time_limit_the_ladder_ends_by_its_budgets_in_work_and_repeats():
+    ompl = _overridden({"guess": "line", "guess_options": {}}, Rung("o", guess="ompl", seed=0), math.inf)
+    assert ompl["guess_options"]["planning_time"] == math.inf and ompl["guess_options"]["max_checks"] == OMPL_CHECKS
+    plans = [plan_simultaneous(CASE2, knots=6, max_wall_time=math.inf) for _ in range(2)]
+    assert all(p.ok for p in plans) and plans[0].stats.iterations == plans[1].stats.iterations
+    np.testing.assert_array_equal(plans[0].trajectory.knots.q, plans[1].trajectory.knots.q)
+
+
+def test_the_default_ladder_starts_with_the_calls_guess_and_ends_uncapped():
+    assert DEFAULT_LADDER[0].guess is None and DEFAULT_LADDER[-1] == Rung(DEFAULT_LADDER[-1].name)
+    assert len({rung.name for rung in DEFAULT_LADDER}) == len(DEFAULT_LADDER)
+
+
+def test_a_plan_that_verifies_on_the_first_rung_reports_one_rung():
+    result = plan_simultaneous(CASE2, knots=6)
+    assert result.ok and result.method["rung"] == DEFAULT_LADDER[0].name
+    assert [r["rung"] for r in result.stats.extra["rungs"]] == [DEFAULT_LADDER[0].name]
+
+
+def test_the_single_shot_reports_no_rungs():
+    result = plan_simultaneous(CASE2, knots=6, fallbacks=SINGLE_SHOT)
+    assert result.ok and "rungs" not in result.stats.extra and "rung" not in result.method
+
+
+def test_single_shot_on_the_command_line_means_no_fallbacks():
+    args = parser().parse_args(["plan", "x.yaml", "--single-shot"])
+    assert _planner_options(args) == {"fallbacks": ()}
+    assert "fallbacks" not in _planner_options(parser().parse_args(["plan", "x.yaml"]))
+
+
+def test_a_failed_ladder_where_ompl_found_no_path_says_so():
+    script = Script({"a": fake("infeasible"), "b": fake("no_path"), "c": fake("iteration_limit")})
+    result = climb(script, LADDER, 60.0)
+    assert result.status == "infeasible" and result.hint == NO_PATH_HINT
+    assert [r["status"] for r in result.stats.extra["rungs"]] == ["infeasible", "no_path", "iteration_limit"]
+    script = Script({"a": fake("no_path"), "b": fake("verified")})
+    assert climb(script, LADDER, 60.0).hint == ""
+
+
+def test_an_ompl_guess_without_a_path_falls_back_to_the_papers_line_only_when_asked():
+    discretization = ocpkit.build(CASE2, knots=6).discretization
+    line = discretization.initial_guess(CASE2)  # the paper's rule, the planner's default
+    np.testing.assert_array_equal(ompl_guess(CASE2, discretization, planning_time=0.0), line)
+    with pytest.raises(NoGuess, match="no_path"):
+        ompl_guess(CASE2, discretization, fallback=False, planning_time=0.0)
+
+
+class Captured(Exception):
+    """Raised by a stand-in planner with the options it was given."""
+
+
+def capture(*args, **options):
+    raise Captured(options)
+
+
+def test_the_random_bench_passes_its_ladder_to_the_planner(monkeypatch):
+    monkeypatch.setattr(random_suite, "plan", capture)
+    with pytest.raises(Captured) as caught:
+        random_suite.run_random(1, 1, fallbacks=SINGLE_SHOT)
+    assert caught.value.args[0]["fallbacks"] == SINGLE_SHOT
+    with pytest.raises(Captured) as caught:
+        random_suite.run_random(1, 1)
+    assert caught.value.args[0]["fallbacks"] == DEFAULT_LADDER
+
+
+def test_the_paper_bench_plans_single_shot(monkeypatch, tmp_path):
+    monkeypatch.setattr(paper, "measure", capture)
+    bench = paper._Bench(Results(tmp_path / "results.csv"), tmp_path, 1, "chebyshev", {})
+    with pytest.raises(Captured) as caught:
+        bench.simultaneous("paper", CASE2, 6, "casadi-rnea", guess="ompl")
+    assert caught.value.args[0]["fallbacks"] == SINGLE_SHOT and caught.value.args[0]["guess"] == "ompl"
+
+
+CAPPED = (Rung("capped", max_iterations=300), Rung("other", guess="ompl"), Rung("uncapped"))
+
+
+@pytest.mark.parametrize("first, runs", [("infeasible", ["capped", "other"]),
+                                         ("iteration_limit", ["capped", "other", "uncapped"])])
+def test_an_uncapped_repeat_runs_only_after_the_cap_was_hit(first, runs):
+    script = Script({"capped": fake(first), "other": fake("no_path"), "uncapped": fake("violated", 0.1)})
+    result = climb(script, CAPPED, 60.0)
+    assert [name for name, _ in script.calls] == runs
+    assert result.stats.extra["skipped"] == ([] if "uncapped" in runs else ["uncapped"])
+
+
+def test_a_rung_whose_guess_has_no_start_ends_no_path_before_any_solve(monkeypatch):
+    def nothing(problem, discretization, fallback=True):
+        raise NoGuess("no start here")
+
+    monkeypatch.setitem(GUESSES._items, "nothing", nothing)
+    plan = plan_simultaneous(CASE2, knots=6, fallbacks=(Rung("n", guess="nothing"),))
+    assert plan.status == "no_path" and plan.stats.iterations == 0 and "no start here" in plan.stats.solver_message
+
+
+class Recording(Script):
+    """A Script that also records the rungs it was given."""
+
+    def __call__(self, rung: Rung | None, left: float) -> Plan:
+        self.rungs = [*getattr(self, "rungs", []), rung]
+        return super().__call__(rung, left)
+
+
+def test_a_plan_violated_only_by_the_dynamics_residual_is_re_solved_on_a_finer_grid_from_its_motion():
+    motion = object()
+    script = Recording({"a": fake("violated", 0.02, seconds=5.0, check="dynamics", trajectory=motion),
+                        "a-finer": fake("verified", seconds=2.0), "b": fake("verified")})
+    result = climb(script, LADDER, 20.0)
+    assert script.calls == [("a", 20.0), ("a-finer", 15.0)]
+    assert script.rungs[1].refines is motion and script.rungs[1].knots == LADDER[0].knots
+    assert result.ok and result.method["rung"] == "a-finer"
+
+
+@pytest.mark.parametrize("plan", [fake("violated", 0.02), fake("infeasible", 0.0, check="dynamics"),
+                                  fake("verified")])
+def test_no_finer_rung_follows_a_plan_a_refinement_round_could_fix_or_that_is_not_violated(plan):
+    assert finer(Rung("a"), plan) is None
+
+
+def test_a_finer_rung_is_capped_and_not_refined_again_nor_relaxed():
+    plan = fake("violated", 0.02, check="dynamics", trajectory=object())
+    rung = finer(Rung("a", guess="ompl", seed=2, segments=3, max_iterations=300, relaxed=True), plan)
+    assert (rung.name, rung.segments, rung.max_iterations, rung.relaxed) == ("a-finer", 3, FINER_ITERATIONS, False)
+    assert (rung.guess, rung.seed, rung.refines) == (None, None, plan.trajectory)  # its start is the motion
+    assert finer(Rung("a", max_iterations=50), plan).max_iterations == 50
+    assert finer(Rung("a"), plan).max_iterations == FINER_ITERATIONS
+    assert finer(rung, plan) is None
+    script = Script({"a": plan, "a-finer": fake("violated", 0.01, check="dynamics"), "b": fake("infeasible"),
+                     "c": fake("infeasible")})
+    climb(script, LADDER, 60.0)
+    assert [name for name, _ in script.calls] == ["a", "a-finer", "b", "c"]
+
+
+@pytest.mark.parametrize("transcription, options, rung, grid", [
+    ("chebyshev", {}, Rung("x"), (12, {"segments": 2})),
+    ("chebyshev", {"segments": 2}, Rung("x", knots=6, segments=3), (6, {"segments": 4})),
+    ("lgl", {"staged": False}, Rung("x"), (12, {"staged": False, "segments": 2})),
+    ("trapezoidal", {}, Rung("x", knots=6, segments=3), (18, {})),
+    ("hermite-simpson", {}, Rung("x", knots=15), (23, {}))])
+def test_a_finer_rung_adds_a_segment_or_half_the_intervals_and_starts_from_the_motion(transcription, options,
+                                                                                      rung, grid):
+    motion = object()
+    call = {"guess": "paper", "guess_options": {}, "knots": 12, "transcription": transcription,
+            "transcription_options": options, "solver_options": {}}
+    changed = _overridden(call, dataclasses.replace(rung, refines=motion), 9.0)
+    assert (changed["knots"], changed["transcription_options"]) == grid
+    assert changed["guess"] == "motion" and changed["guess_options"] == {"trajectory": motion}
+
+
+def test_the_motion_guess_samples_a_trajectory_on_another_grid():
+    plan = plan_simultaneous(CASE2, knots=6, fallbacks=SINGLE_SHOT)
+    coarse = plan.trajectory
+    discretization = ocpkit.build(CASE2, knots=6, transcription_options={"segments": 2}).discretization
+    w = GUESSES.get("motion")(CASE2, discretization, trajectory=coarse)
+    sampled = discretization.decode(w)
+    assert sampled.tf == pytest.approx(coarse.tf)
+    np.testing.assert_allclose(sampled.knots.q, coarse.interpolant(sampled.knots.t).q, atol=1e-9)
+    with pytest.raises(OptionError, match="guess 'motion' needs"):
+        GUESSES.get("motion")(CASE2, discretization)
+    fewer = Trajectory(dataclasses.replace(coarse.knots, q=coarse.knots.q[:, :5]), coarse.interpolant)
+    with pytest.raises(OptionError, match="moves 5 joints, the robot has 6"):
+        GUESSES.get("motion")(CASE2, discretization, trajectory=fewer)

@@ -1,0 +1,84 @@
+"""Active-set screening of collision rows (ocpkit.planner.screening, SphereCollision.screened / missing)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ocpkit.constraints import make_constraints
+from ocpkit.constraints.collision import SphereCollision
+from ocpkit.formats.scenario import load_scenario
+from ocpkit.geometry.clearances import clearances, sphere_centers_batch
+from ocpkit.planner.screening import line_samples, worth_screening
+from ocpkit.planner.simultaneous import (
+    END_CHECK_CLEARANCE,
+    _checked_near_the_ends,
+    plan_simultaneous,
+)
+from ocpkit.transcription.pseudospectral import long_interval_midpoints
+from tests.helpers import REPO
+
+PANDA = load_scenario(REPO / "scenarios/mbm/panda/table_pick/0001.yaml")
+PAPER = load_scenario(REPO / "scenarios/paper/case2.yaml")
+PLAN_OPTIONS = {"transcription": "chebyshev", "transcription_options": {}}
+
+
+def test_screening_keeps_exactly_the_terms_close_to_some_configuration():
+    full = SphereCollision(PANDA)
+    near = line_samples(PANDA)
+    kept = full.screened(PANDA, near, 0.2)
+    c = clearances(PANDA.robot, PANDA.scene, sphere_centers_batch(PANDA.robot, near))
+    assert np.array_equal(kept.pair_mask, full.pair_mask & (c.self_pairs.min(axis=0) < 0.2))
+    assert np.array_equal(kept.obstacle_mask, full.obstacle_mask & (c.obstacles.min(axis=0) < 0.2))
+    assert 0 < kept.term_count < full.term_count / 2  # far fewer rows, but not none
+    assert kept.shape() != full.shape()  # a screened build is a different build
+    assert full.term_count == len(full.pairs) + full.obstacle_mask.sum()  # no workspace in MBM scenes
+
+
+def test_missing_counts_the_left_out_terms_near_other_configurations():
+    near = line_samples(PANDA)
+    kept = SphereCollision(PANDA).screened(PANDA, near, 0.2)
+    assert kept.missing(PANDA, near, 0.1) == 0  # everything within 0.2 m there is kept
+    rng = np.random.default_rng(0)
+    elsewhere = rng.uniform(PANDA.robot.q_lower, PANDA.robot.q_upper, (50, PANDA.robot.n))
+    c = clearances(PANDA.robot, PANDA.scene, sphere_centers_batch(PANDA.robot, elsewhere))
+    close = (c.self_pairs.min(axis=0) < 0.1) & kept.pair_mask.__invert__() & SphereCollision(PANDA).pair_mask
+    assert kept.missing(PANDA, elsewhere, 0.1) >= close.sum() > 0
+
+
+def test_constraints_with_any_collision_terms_are_worth_screening():
+    assert worth_screening(make_constraints(PANDA))
+    assert worth_screening(make_constraints(PAPER))  # the paper's robot screens too
+    assert not worth_screening(make_constraints(PAPER, ("state-limits", "torque", "torque-rate")))
+
+
+def test_other_constraints_are_not_screened():
+    made = make_constraints(PANDA, screen=(line_samples(PANDA), 0.2))
+    unscreened = make_constraints(PANDA)
+    assert [c.shape() for c in made[:-1]] == [c.shape() for c in unscreened[:-1]]
+
+
+@pytest.mark.slow
+def test_a_screened_plan_is_verified_on_every_term():
+    plan = plan_simultaneous(PAPER, fallbacks=(), screen=True)
+    assert plan.status == "verified"  # verification checks every term, screened or not
+    assert plan.stats.extra["screening"]["rows_per_point"] < SphereCollision(PAPER).term_count
+
+
+def test_every_knot_interval_is_checked_when_asked():
+    points = np.cos(np.pi * np.arange(13) / 12)  # Chebyshev–Lobatto, N = 12
+    long_only, every = long_interval_midpoints(points), long_interval_midpoints(points, every=True)
+    assert len(every) == 12 and len(long_only) == 8  # sin θ ≥ ½ keeps the middle 8 of 12
+    assert set(np.round(long_only, 12)) <= set(np.round(every, 12))
+    assert np.all((every[:-1] - points[1:-1]) * (every[1:] - points[1:-1]) < 0)  # one between each pair of knots
+
+
+def test_a_plan_checks_near_the_ends_when_an_end_is_close_to_contact_unless_told_otherwise():
+    assert PANDA.end_clearances.smallest() < END_CHECK_CLEARANCE  # MBM's goal on the table
+    assert _checked_near_the_ends(PANDA, PLAN_OPTIONS)["transcription_options"] == {"end_checks": True}
+    assert PAPER.end_clearances.smallest() >= END_CHECK_CLEARANCE
+    assert _checked_near_the_ends(PAPER, PLAN_OPTIONS) is PLAN_OPTIONS  # the paper's ends are clear of everything
+    told = {**PLAN_OPTIONS, "transcription_options": {"end_checks": False}}
+    assert _checked_near_the_ends(PANDA, told) is told
+    mesh = {**PLAN_OPTIONS, "transcription": "trapezoidal"}
+    assert _checked_near_the_ends(PANDA, mesh) is mesh  # a mesh transcription has no such option

@@ -1,0 +1,161 @@
+"""`finish` (status and stats of a Plan) and `ocpkit.plan` (validation before any planner, option errors)."""
+
+from __future__ import annotations
+
+import dataclasses
+import types
+
+import numpy as np
+import pytest
+from helpers import REPO, monomial, polynomial_motion
+
+import ocpkit
+from ocpkit import result as result_module
+from ocpkit.errors import OptionError, ScenarioError
+from ocpkit.geometry.clearances import sphere_centers
+from ocpkit.geometry.scene import Scene
+from ocpkit.planner import PLANNERS
+from ocpkit.result import finish
+from ocpkit.verify import Check, Verification
+
+CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
+FREE = dataclasses.replace(CASE2, scene=Scene(workspace=CASE2.scene.workspace))
+PASSED = Verification((Check("torque", -0.5, 0.01, 0.1, "rel"),), np.zeros(0))
+FAILED = Verification((Check("torque", 0.5, 0.01, 0.1, "rel"),), np.array([0.1]))
+MINIMUM_JERK = 10 * monomial(3) - 15 * monomial(4) + 6 * monomial(5)
+
+
+@pytest.fixture
+def motion():
+    return polynomial_motion(FREE, 4.0, MINIMUM_JERK)
+
+
+@pytest.fixture
+def clock(monkeypatch):
+    """ocpkit.plan's clock, frozen at 10 s."""
+    monkeypatch.setattr(result_module, "time", types.SimpleNamespace(perf_counter=lambda: 10.0))
+
+
+@pytest.mark.parametrize("given, status", [(PASSED, "verified"), (FAILED, "violated")])
+def test_a_finished_plan_is_verified_or_violated_as_the_verification_says(motion, given, status):
+    result = finish(FREE, motion, None, {"planner": "test"}, 0.0, verification=given)
+    assert result.status == status and result.ok == (status == "verified")
+    assert result.verification is given and result.method == {"planner": "test"}
+
+
+@pytest.mark.parametrize("given", [PASSED, FAILED])
+def test_the_planners_word_is_the_status_when_it_stopped(motion, given):
+    result = finish(FREE, motion, "iteration_limit", {}, 0.0, verification=given)
+    assert result.status == "iteration_limit" and not result.ok
+
+
+def test_finish_verifies_the_trajectory_when_no_verification_is_given(motion):
+    result = finish(FREE, motion, None, {}, 0.0)
+    assert result.status == "verified", result.verification.summary()
+    assert {c.name for c in result.verification.checks} >= {"torque", "obstacle", "boundary"}
+    moved = dataclasses.replace(FREE, goal=FREE.goal + 0.01)
+    assert finish(moved, motion, None, {}, 0.0).status == "violated"  # the motion misses the goal
+
+
+def test_solve_time_excludes_the_setup_time(motion, clock):
+    result = finish(FREE, motion, None, {}, started=4.0, setup_time=1.5, iterations=12, rounds=2, message="ok",
+                    extra={"k": 1}, verification=PASSED)
+    stats = result.stats
+    assert stats.solve_time == pytest.approx(4.5) and stats.setup_time == 1.5
+    assert (stats.iterations, stats.rounds, stats.solver_message, stats.extra) == (12, 2, "ok", {"k": 1})
+
+
+def test_stats_extra_defaults_to_an_empty_dict(motion, clock):
+    assert finish(FREE, motion, None, {}, 10.0, verification=PASSED).stats.extra == {}
+
+
+@pytest.fixture
+def spy(monkeypatch):
+    """A registered planner `spy(problem, speed=1.0)` that records its calls."""
+    calls = []
+
+    def planner(problem, speed: float = 1.0):
+        calls.append((problem, speed))
+        return "planned"
+
+    monkeypatch.setitem(PLANNERS._items, "spy", planner)
+    return calls
+
+
+def test_a_valid_problem_reaches_the_planner_with_its_options(spy):
+    assert ocpkit.plan(CASE2, "spy", speed=2.0) == "planned"
+    assert spy == [(CASE2, 2.0)]
+
+
+def test_a_start_outside_the_limits_is_refused_naming_the_joint(spy):
+    start = CASE2.start.copy()
+    start[1] = CASE2.robot.q_upper[1] + 0.1
+    with pytest.raises(ScenarioError, match=r"start: joint 2 \(joint_2\)"):
+        ocpkit.plan(dataclasses.replace(CASE2, start=start), "spy")
+    assert spy == []
+
+
+def test_a_start_in_collision_is_refused(spy):
+    centre = sphere_centers(CASE2.robot, CASE2.start)[12]
+    blocked = dataclasses.replace(CASE2, scene=Scene(centre[None], np.array([0.05]), CASE2.scene.workspace))
+    with pytest.raises(ScenarioError, match="start configuration is in collision: .*sphere 12"):
+        ocpkit.plan(blocked, "spy")
+    assert spy == []
+
+
+def test_nan_in_the_goal_is_refused(spy):
+    goal = CASE2.goal.copy()
+    goal[3] = np.nan
+    with pytest.raises(ScenarioError, match="goal needs 6 finite joint values"):
+        ocpkit.plan(dataclasses.replace(CASE2, goal=goal), "spy")
+    assert spy == []
+
+
+def test_an_option_the_planner_does_not_take_lists_its_options(spy):
+    with pytest.raises(OptionError, match="bogus") as error:
+        ocpkit.plan(CASE2, "spy", bogus=1)
+    assert str(error.value).endswith("its options: speed") and spy == []
+
+
+def test_an_option_the_simultaneous_planner_does_not_take_lists_its_options():
+    with pytest.raises(OptionError, match="'planner_name'") as error:
+        ocpkit.plan(CASE2, planner_name="rrtconnect")
+    assert all(option in str(error.value) for option in ("knots", "solver", "refinements", "constraints"))
+
+
+def verification_failing(*names: str) -> Verification:
+    """A verification whose named checks fail (and a passing torque check)."""
+    return Verification((Check("torque", -0.5, 0.01, 0.1, "rel"),)
+                        + tuple(Check(name, 0.5, 0.01, 0.1, "rel") for name in names), np.zeros(0))
+
+
+@pytest.mark.parametrize("stopped, failing, words", [
+    ("infeasible", (), "locally infeasible"),
+    ("iteration_limit", (), "raise max_iterations"),
+    ("time_limit", (), "raise max_wall_time"),
+    ("no_path", (), "raise planning_time"),
+    (None, ("dynamics",), "more knots or segments"),
+    (None, ("qd_consistency",), "more knots or segments"),
+    (None, ("obstacle", "velocity"), "contact remains"),
+    (None, ("torque_rate",), "a limit is exceeded"),
+    (None, ("motion_time",), "solver diverged"),
+])
+def test_the_hint_follows_the_cause(motion, stopped, failing, words):
+    result = finish(FREE, motion, stopped, {}, 0.0, message="Some_Status", verification=verification_failing(*failing))
+    assert words in result.hint
+    assert result.hint.count(". ") == 0  # one sentence
+
+
+def test_a_failed_plan_quotes_the_solvers_message(motion):
+    result = finish(FREE, motion, "failed", {}, 0.0, message="Search_Direction_Becomes_Too_Small",
+                    verification=PASSED)
+    assert "Search_Direction_Becomes_Too_Small" in result.hint
+
+
+def test_a_verified_plan_has_no_hint(motion):
+    assert finish(FREE, motion, None, {}, 0.0, verification=PASSED).hint == ""
+
+
+def test_a_plan_has_a_trajectory_unless_the_planner_says_it_found_none(motion):
+    assert finish(FREE, motion, None, {}, 0.0, verification=PASSED).found
+    assert not finish(FREE, motion, "no_path", {}, 0.0, verification=PASSED, found=False).found
