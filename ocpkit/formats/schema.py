@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import numbers
 import operator
+import re
 import reprlib
 from abc import ABC, abstractmethod
 from collections.abc import Sequence as SequenceABC
@@ -29,7 +30,19 @@ SHOWN_CHARS = 80
 """Longest echo of a user's value in an error message, characters."""
 _REPR = reprlib.Repr()
 _REPR.maxstring = _REPR.maxother = SHOWN_CHARS
-_SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's when built: a 10 MB file in a second
+_FLOAT = "tag:yaml.org,2002:float"
+
+
+class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # libyaml's parser where PyYAML was built with it
+    """PyYAML's safe loader reading floats by YAML 1.2's core schema: `1.0e6`, `1e-3`, `2e-1` and `.inf` are
+    numbers (PyYAML follows YAML 1.1, where an exponent needs a dot and a sign, so `1.0e6` is a string)."""
+
+
+_Loader.yaml_implicit_resolvers = {first: [(tag, rx) for tag, rx in resolvers if tag != _FLOAT]
+                                   for first, resolvers in _Loader.yaml_implicit_resolvers.items()}
+_Loader.add_implicit_resolver(_FLOAT, re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+                                                  r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
+                              list("-+0123456789."))
 Sign = Literal["positive", "non-negative"]
 _SIGNS = {"positive": ("> 0", operator.gt), "non-negative": ("≥ 0", operator.ge)}
 
@@ -281,7 +294,7 @@ def read_bytes(path: Path, error: type[OcpkitError], what: str) -> bytes:
 def read_yaml(text: bytes, error: type[OcpkitError]) -> Any:
     """Parse UTF-8 YAML bytes; raise `error` with a one-line message (line and column for a syntax error)."""
     try:
-        return yaml.load(text.decode("utf-8"), Loader=_SAFE_LOADER)
+        return yaml.load(text.decode("utf-8"), Loader=_Loader)
     except UnicodeDecodeError as exc:
         raise error(f"not UTF-8 text: byte {text[exc.start]:#04x} at offset {exc.start}") from None
     except yaml.MarkedYAMLError as exc:
