@@ -108,12 +108,13 @@ class Discretization(ABC):
         `refinement`: the warm start of a solve whose checks sit elsewhere than those w was solved with (a
         refinement round, a rebuild), which would otherwise start with the lifting rows violated."""
         values = np.array(w, dtype=float)
-        self.write_checks(values, self.decode(values), refinement)
+        self.write_checks(values, self.decode(values, chain=True), refinement)
         return values
 
     @abstractmethod
-    def decode(self, w: np.ndarray) -> Trajectory:
-        """The trajectory that the decision vector w represents."""
+    def decode(self, w: np.ndarray, chain: bool = False) -> Trajectory:
+        """The trajectory that the decision vector w represents; with `chain`, the trajectory of the OCP's chain
+        (x, ẋ, ẍ in the Samples' q, qd, qdd; u and du/dt as tau and taud), as `encode` and `write_checks` take it."""
 
 
 class Transcription(ABC):
@@ -123,8 +124,8 @@ class Transcription(ABC):
 
     name: str
     max_intervals: ClassVar[int]
-    """The most knot intervals (over all segments) it builds within about a minute and 1.5 GB on 2 cores
-    (docs/design-notes.md)."""
+    """The most knot intervals (over all segments) it builds: a larger NLP takes too long and too much memory to
+    build (figures: docs/design-notes.md)."""
 
     @abstractmethod
     def free_path_values(self, knots: int) -> int:

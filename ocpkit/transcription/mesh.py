@@ -56,8 +56,9 @@ class MeshInterpolant:
     """The method's interpolant of decoded knot (and midpoint) rows, for any t in [0, t_f]."""
 
     def __init__(self, tf: float, knots: np.ndarray, mids: np.ndarray | None, interpolate: Interpolate,
-                 ocp: OCP) -> None:
+                 ocp: OCP, chain: bool = False) -> None:
         self.tf, self.knots, self.mids, self.interpolate, self.ocp = tf, knots, mids, interpolate, ocp
+        self.chain = chain  # samples of the OCP's chain (Discretization.decode) instead of the robot's
 
     def __call__(self, t: np.ndarray) -> Samples:
         N = len(self.knots) - 1
@@ -67,7 +68,9 @@ class MeshInterpolant:
         node = self.ocp.split
         mid = None if self.mids is None else node(self.mids[k])
         v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, h, (at - k)[:, None])
-        return self.ocp.samples(t, Node(v.q, v.qd, v.qdd, v.u), v.du_ds / h, v.dqdd_ds / h)
+        x = Node(v.q, v.qd, v.qdd, v.u)
+        return self.ocp.chain_samples(t, x, v.du_ds / h) if self.chain else self.ocp.samples(t, x, v.du_ds / h,
+                                                                                             v.dqdd_ds / h)
 
 
 class MeshDiscretization(Discretization):
@@ -196,11 +199,11 @@ class MeshDiscretization(Discretization):
         at = trajectory.tf * (np.arange(self.N) + self._check_at(refinement)) / self.N
         self.nlp.variables.write(values, "q_check", trajectory.interpolant(at).q)
 
-    def decode(self, w: np.ndarray) -> Trajectory:
+    def decode(self, w: np.ndarray, chain: bool = False) -> Trajectory:
         layout = self.nlp.variables
         knots, tf = layout.read(w, "X"), float(layout.read(w, "tf")[0])
         mids = layout.read(w, "M") if self.midpoints else None
-        interpolant = MeshInterpolant(tf, knots, mids, self.interpolate, self.ocp)
+        interpolant = MeshInterpolant(tf, knots, mids, self.interpolate, self.ocp, chain)
         return Trajectory(interpolant(tf * np.arange(self.N + 1) / self.N), interpolant)
 
 

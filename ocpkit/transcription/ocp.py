@@ -135,6 +135,11 @@ class OCP(ABC):
     def columns(self, chain: Samples) -> np.ndarray:
         """Rows [x, ẋ, ẍ, u] (points, width) of sampled chain values (x, ẋ, ẍ in the Samples' q, qd, qdd)."""
 
+    def chain_samples(self, t: np.ndarray, x: Node, du_dt: np.ndarray) -> Samples:
+        """The chain's own samples at times t (points,): x, ẋ, ẍ as the Samples' q, qd, qdd and u, du/dt as tau,
+        taud, as `Discretization.encode` and `write_checks` read them."""
+        return Samples(np.asarray(t, dtype=float), x.q, x.qd, x.qdd, x.u, du_dt)
+
     @abstractmethod
     def samples(self, t: np.ndarray, x: Node, du_dt: np.ndarray, dxdd_dt: np.ndarray) -> Samples:
         """Robot samples at times t (points,) from interpolated node rows and the interpolant's du/dt

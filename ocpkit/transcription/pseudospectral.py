@@ -82,12 +82,14 @@ class PseudospectralInterpolant:
     columns: np.ndarray
     ocp: OCP
     grid: Grid
+    chain: bool = False  # samples of the OCP's chain (Discretization.decode) instead of the robot's
 
     def __call__(self, t: np.ndarray) -> Samples:
         L, Ld = self.grid.matrices(2.0 * np.asarray(t, dtype=float) / self.tf - 1.0)
         values, rates = L @ self.columns.T, Ld @ self.columns.T * (2.0 * self.grid.K / self.tf)
         m = self.ocp.chain
-        return self.ocp.samples(t, self.ocp.split(values), rates[:, 3 * m:], rates[:, 2 * m:3 * m])
+        x, du_dt = self.ocp.split(values), rates[:, 3 * m:]
+        return self.ocp.chain_samples(t, x, du_dt) if self.chain else self.ocp.samples(t, x, du_dt, rates[:, 2 * m:3 * m])
 
 
 def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
@@ -185,10 +187,10 @@ class PseudospectralDiscretization(Discretization):
         for part in CHECK_PARTS:
             self.nlp.variables.write(values, f"{part}_check", getattr(checks, part).T)
 
-    def decode(self, w: np.ndarray) -> Trajectory:
+    def decode(self, w: np.ndarray, chain: bool = False) -> Trajectory:
         layout = self.nlp.variables
         columns, tf = layout.read(w, "X").T, float(layout.read(w, "tf")[0])
-        interpolant = PseudospectralInterpolant(tf, columns, self.ocp, self.grid)
+        interpolant = PseudospectralInterpolant(tf, columns, self.ocp, self.grid, chain)
         return Trajectory(interpolant(tf * (self.grid.knots[::-1] + 1.0) / 2.0), interpolant)
 
 
