@@ -3,8 +3,9 @@
 Every check reports its worst value over a dense time grid (1 ms by default) and passes when that is
 within the stated tolerance:
 
-  position, velocity, torque, torque_rate   worst excess over the limit, relative (position: to the joint's
-                                             range; others: to the limit itself);  tolerance 1 %
+  position    worst excess over a joint's position limit, rad (m for a prismatic joint);  tolerance 1e-4
+              (a hard stop: ocpkit.tolerances)
+  velocity, torque, torque_rate             worst excess over the limit, relative to it;  tolerance 1 %
   dynamics    |tau(t) − (rnea(q, qd, qdd) + friction)| relative to the torque range 2·tau_max;  tolerance 1 %
   self_collision, obstacle, workspace       worst sphere penetration, metres (negative: the smallest
                                              clearance);  tolerance 0 (no contact allowed)
@@ -38,6 +39,7 @@ from ocpkit.tolerances import (
     DYNAMICS_TOLERANCE,
     GEOMETRY_TOLERANCE,
     LIMIT_TOLERANCE,
+    POSITION_TOLERANCE,
     QD_CONSISTENCY_TOLERANCE,
     QDD_CONSISTENCY_TOLERANCE,
 )
@@ -48,13 +50,15 @@ SCALED_LIMITS = ("velocity", "torque", "torque_rate")
 
 @dataclass(frozen=True)
 class Check:
-    """One verified quantity: its worst value, the tolerance it must not exceed, and when it occurred (s)."""
+    """One verified quantity: its worst value, the tolerance it must not exceed, when it occurred (s) and, for a
+    per-joint check, at which joint (`where`; "" otherwise)."""
 
     name: str
     worst: float
     tolerance: float
     time: float
     unit: str
+    where: str = ""
 
     @property
     def ok(self) -> bool:
@@ -93,7 +97,7 @@ class Verification:
         failed = [c for c in self.checks if not c.ok]
         if failed:
             return "FAILED " + ", ".join(f"{c.name} {c.worst:+.3g} {c.unit} > {c.tolerance:g} at t={c.time:.3f} s"
-                                         for c in failed)
+                                         + (f" ({c.where})" if c.where else "") for c in failed)
         return "all pass: " + ", ".join(f"{c.name} {c.worst:+.3g} {c.unit}" for c in self.checks)
 
 
@@ -105,21 +109,22 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
     samples = trajectory.sample(dt)
     robot = problem.robot
     tau_needed = _inverse_dynamics(problem, samples)
-    excess = {
-        "position": np.maximum(samples.q - robot.q_upper, robot.q_lower - samples.q) / (robot.q_upper - robot.q_lower),
-        "velocity": np.abs(samples.qd) / robot.qd_max - 1.0,
-        "torque": np.abs(tau_needed) / robot.tau_max - 1.0,
-        "torque_rate": np.abs(samples.taud) / robot.taud_max - 1.0,
+    excess = {  # name: (values (m, n), tolerance, unit)
+        "position": (np.maximum(samples.q - robot.q_upper, robot.q_lower - samples.q), POSITION_TOLERANCE, "rad"),
+        "velocity": (np.abs(samples.qd) / robot.qd_max - 1.0, LIMIT_TOLERANCE, "rel"),
+        "torque": (np.abs(tau_needed) / robot.tau_max - 1.0, LIMIT_TOLERANCE, "rel"),
+        "torque_rate": (np.abs(samples.taud) / robot.taud_max - 1.0, LIMIT_TOLERANCE, "rel"),
     }
     consistency = np.abs(samples.tau - tau_needed) / (2.0 * robot.tau_max)
     c = clearances(robot, problem.scene, sphere_centers_batch(robot, samples.q))
     penetration = dict(zip(GEOMETRY_CHECKS, (-c.self_pairs, -c.obstacles, -c.workspace)))
-    checks = [_worst(name, v, LIMIT_TOLERANCE, samples.t, "rel") for name, v in excess.items()]
+    checks = [_worst(name, v, tolerance, samples.t, unit, robot.joint_names)
+              for name, (v, tolerance, unit) in excess.items()]
     checks.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))
     checks += [_worst(name, v, GEOMETRY_TOLERANCE, samples.t, "m") for name, v in penetration.items()]
     checks.append(_boundary(problem, samples))
     checks += _consistency(problem, samples)
-    path_violation = np.max([_per_time(v) - LIMIT_TOLERANCE for v in excess.values()]
+    path_violation = np.max([_per_time(v) - tolerance for v, tolerance, _ in excess.values()]
                             + [_per_time(v) for v in penetration.values()], axis=0)
     return Verification(tuple(checks), _peak_times(samples.t, path_violation))
 
@@ -144,10 +149,14 @@ def _per_time(values: np.ndarray) -> np.ndarray:
     return flat.max(axis=1) if flat.shape[1] else np.full(len(values), -np.inf)
 
 
-def _worst(name: str, values: np.ndarray, tolerance: float, t: np.ndarray, unit: str) -> Check:
+def _worst(name: str, values: np.ndarray, tolerance: float, t: np.ndarray, unit: str,
+           joints: tuple[str, ...] = ()) -> Check:
+    """The check of `values` (m, ...) at times t (m,): its worst value and when; with `joints` (values (m, n),
+    one column per joint), the joint where it occurred."""
     per_time = _per_time(values)
     k = int(np.argmax(per_time))
-    return Check(name, float(per_time[k]), tolerance, float(t[k]), unit)
+    where = joints[int(np.argmax(values[k]))] if joints and values.shape[1:] == (len(joints),) else ""
+    return Check(name, float(per_time[k]), tolerance, float(t[k]), unit, where)
 
 
 def _consistency(problem: Problem, samples: Samples) -> list[Check]:

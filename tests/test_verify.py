@@ -107,3 +107,32 @@ def test_a_jump_in_acceleration_is_consistent():
 
     checks = by_name(verify(PROBLEM, Trajectory(at(np.array([0.0, 1.0005, tf])), at)))
     assert checks["qd_consistency"].ok and checks["qdd_consistency"].worst < 1e-9
+
+
+RISING = int(np.argmax(PROBLEM.goal - PROBLEM.start))  # a joint whose quintic motion rises to its goal
+
+
+def limited_above(problem, joint: int, excess: float):
+    """`problem` whose joint `joint` has its upper position limit `excess` rad below the goal, which the quintic
+    motion reaches only at its end (it rises monotonically)."""
+    robot = problem.robot
+    upper = robot.q_upper.copy()
+    upper[joint] = problem.goal[joint] - excess
+    return dataclasses.replace(problem, robot=dataclasses.replace(robot, q_upper=upper))
+
+
+def test_a_position_limit_is_hard_half_a_percent_past_is_violated_naming_joint_and_time():
+    robot, joint = PROBLEM.robot, RISING
+    excess = 0.005 * (robot.q_upper[joint] - robot.q_lower[joint])  # within the old 1 % of the range
+    checks = by_name(verify(limited_above(PROBLEM, joint, excess), quintic(PROBLEM, 4.0)))
+    position = checks["position"]
+    assert not position.ok and position.unit == "rad"
+    assert position.worst == pytest.approx(excess, rel=1e-6)
+    assert position.where == robot.joint_names[joint] and position.time == pytest.approx(4.0, abs=2e-3)
+    summary = verify(limited_above(PROBLEM, joint, excess), quintic(PROBLEM, 4.0)).summary()
+    assert f"({robot.joint_names[joint]})" in summary and "t=4.000 s" in summary
+
+
+def test_round_off_past_a_position_limit_passes():
+    checks = by_name(verify(limited_above(PROBLEM, RISING, 5e-5), quintic(PROBLEM, 4.0)))
+    assert checks["position"].ok and checks["position"].worst == pytest.approx(5e-5, rel=1e-6)
