@@ -85,7 +85,32 @@ class Registry(Generic[T]):
         """Every known name: from entry points and registered at run time."""
         return sorted(set(self._items) | {p.name for p in _entry_points(self.group)})
 
-    def description(self, name: str) -> str:
-        """One line about the component `name`: its docstring's first paragraph (loads the component)."""
-        doc = inspect.getdoc(self.get(name)) or ""
-        return " ".join(doc.split("\n\n")[0].split())
+    def description(self, name: str, width: int | None = None) -> str:
+        """One line about the component `name`: the first sentence of its docstring, cut to `width` characters
+        (ending in "…") when it is longer (loads the component)."""
+        return summary(inspect.getdoc(self.get(name)) or "", width)
+
+
+def summary(doc: str, width: int | None = None) -> str:
+    """The first sentence of `doc` on one line: up to the first full stop outside brackets and backticks that
+    ends the first paragraph or is followed by a space and no lower-case letter (so "e.g. x" and "(et al.)" do
+    not end it); cut at a word boundary to at most `width` characters, ending in "…", if it is longer."""
+    text = " ".join(doc.split("\n\n")[0].split())
+    depth, quoted = 0, False
+    for i, char in enumerate(text):
+        if char == "`":
+            quoted = not quoted
+        elif not quoted and char in "([{":
+            depth += 1
+        elif not quoted and char in ")]}":
+            depth = max(depth - 1, 0)
+        elif char == "." and depth == 0 and not quoted and (i + 1 == len(text) or text[i + 1] == " " and
+                                                            not text[i + 2:i + 3].islower()):
+            text = text[:i + 1]
+            break
+    if width is None or len(text) <= width:
+        return text
+    cut = text[:width - 1]
+    if " " in cut and text[width - 1] != " ":
+        cut = cut[:cut.rindex(" ")]
+    return cut.rstrip(" ,;:") + "…"

@@ -1,7 +1,7 @@
 """Generate the figures of docs/transcription.md into docs/figures/.
 
     PYTHONPATH=. python scripts/make_figures.py            # all figures; re-plots convergence.csv if present
-    PYTHONPATH=. python scripts/make_figures.py --rerun    # also re-run the convergence study (~3 min)
+    PYTHONPATH=. python scripts/make_figures.py --rerun    # also re-run the convergence study (slow)
 
 knots.png          Chebyshev–Lobatto knots vs uniform knots on [0, t_f]
 dmatrix.png        the Chebyshev differentiation matrix D (N = 12) as a heat map

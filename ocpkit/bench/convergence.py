@@ -17,8 +17,9 @@ own tolerance sits below the discretization errors we measure.
 References (the t_f_ref against which t_f errors are measured):
   paper    hermite-simpson at 80 intervals: a local method converges at its algebraic rate even through the
            constraint switches (which a global polynomial cannot), and imposes the path constraints at 161
-           points. Trapezoidal at 160 intervals lies 8e-5 s from it (its own O(h²) trend), so paper-case
-           errors below ~5e-5 s are within the reference's uncertainty.
+           points. Paper-case errors as small as its own discretization error (estimated by the finest
+           trapezoidal point's distance from it; figures: docs/design/moved-from-code.md) lie within the
+           reference's uncertainty.
   smooth   chebyshev at 32: with no active bound the Euler–Lagrange equation of t_f + μ∫q⃛ᵀQq⃛ dt is q⁽⁶⁾ = 0,
            so the optimal q(t) is a quintic, which a degree-N Chebyshev polynomial (N ≥ 5) represents
            exactly.

@@ -2,7 +2,7 @@
 by the calling thread alone.
 
 Why not concurrent.futures.ProcessPoolExecutor: its results come back through one queue read by a background
-thread, and a worker terminated while writing a large result (a trajectory is ~1 MB, sent in pipe-sized pieces)
+thread, and a worker terminated while writing a large result (a trajectory, sent in many pipe-sized pieces)
 leaves that thread waiting for the rest forever, so the interpreter hangs at exit after Ctrl-C. Here the parent
 holds no copy of a worker's end of its pipe, so a dead worker reads as end-of-file, and there is no thread to join.
 """

@@ -8,7 +8,7 @@ excess √(p_x² + p_y²) − R and the axial excess |p_z| − L/2). Its feasibl
 no conservatism) and it is continuously differentiable with a Lipschitz gradient (|·| and the norm's kink lie where
 max(·, 0) is already 0); only its second derivative jumps across the planes of the faces, which IPOPT tolerates.
 Its weakness: inside the obstacle the row is flat (zero gradient), so a guess deep inside a box gives IPOPT no
-direction there (the ladder's OMPL guess is the remedy). Rows and solve time: `ocpkit bench shapes` (README).
+direction there (the ladder's OMPL guess is the remedy). `ocpkit bench shapes` measures their rows and solve time.
 
 Terms that can never be active are left out, which keeps the NLP (and IPOPT's KKT system) small: every
 robot sphere stays within its reach ρ of a fixed anchor (`ocpkit.robots.sphere_reach`), so a sphere whose
@@ -55,8 +55,9 @@ def active_terms(problem: Problem) -> tuple[np.ndarray, np.ndarray]:
 
 
 class SphereCollision(Constraint):
-    """Clearance ≥ margin (m) between robot spheres, to the obstacles (spheres, boxes, cylinders) and to the
-    workspace box."""
+    """Clearance ≥ margin (m) between robot spheres, to the obstacles and to the workspace box.
+
+    Obstacles are spheres, boxes and cylinders (module docstring)."""
 
     name = "collision"
 

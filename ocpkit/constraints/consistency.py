@@ -7,8 +7,8 @@ At a collocation point the transcription's defect makes τ = rnea(q, q̇, q̈) +
 quantity at the check points, so a solve cannot end on a motion whose torque is consistent only at the knots. At the
 knots it is the defect itself (`at_knots` "bounds" with no bounds of its own: no rows there).
 
-Not a default: its rows hold the inverse dynamics at every check point, which makes an IPOPT iteration about twice as
-dear (README.md, "Dynamics between knots"). Add it to a plan's constraints when coarse knots leave a residual:
+Not a default: its rows hold the inverse dynamics at every check point, which makes every IPOPT iteration dearer
+(figures: docs/design-notes.md). Add it to a plan's constraints when coarse knots leave a residual:
 `ocpkit.plan(problem, constraints=(*DEFAULT_CONSTRAINTS, "dynamics-consistency"))`.
 """
 
@@ -26,7 +26,9 @@ interpolants between check points."""
 
 
 class DynamicsConsistency(Constraint):
-    """|τ − (rnea(q, q̇, q̈) + friction(q̇))| / (2 τ_max) ≤ CONSISTENCY_BOUND at check points (dimensionless)."""
+    """Dynamics between knots: |τ − rnea − friction| / (2 τ_max) ≤ CONSISTENCY_BOUND at check points.
+
+    rnea(q, q̇, q̈) + friction(q̇) is the torque the motion needs; the bound is dimensionless (module docstring)."""
 
     name = "dynamics-consistency"
     at_knots = "bounds"

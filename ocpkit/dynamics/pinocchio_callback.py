@@ -209,8 +209,10 @@ class _CallbackDefect:
 
 
 class PinocchioAba(_CallbackDefect, CasadiAba):
-    """Forward form with pinocchio's numeric ABA and its analytic derivatives (computeABADerivatives) in the
-    defect q̈ − ABA(q, q̇, τ_rigid), rad/s² (module docstring)."""
+    """Forward form by numeric pinocchio: the defect is q̈ − ABA(q, q̇, τ_rigid) in rad/s².
+
+    ABA and its analytic derivatives (computeABADerivatives) through a CasADi callback: first derivatives only
+    (module docstring)."""
 
     name = "pinocchio"
     algorithm = ABA
@@ -221,8 +223,10 @@ class PinocchioAba(_CallbackDefect, CasadiAba):
 
 
 class PinocchioRnea(_CallbackDefect, CasadiRnea):
-    """Inverse form with pinocchio's numeric RNEA and its analytic derivatives (computeRNEADerivatives) in the
-    defect (RNEA(q, q̇, q̈) − τ_rigid) / τ_max, dimensionless (module docstring)."""
+    """Inverse form by numeric pinocchio: the defect is (RNEA(q, q̇, q̈) − τ_rigid) / τ_max, dimensionless.
+
+    RNEA and its analytic derivatives (computeRNEADerivatives) through a CasADi callback: first derivatives only
+    (module docstring)."""
 
     name = "pinocchio-rnea"
     algorithm = RNEA

@@ -218,16 +218,18 @@ class CasadiNlpsol(Solver):
 
 
 class Ipopt(CasadiNlpsol):
-    """IPOPT with exact Hessian by CasADi AD (L-BFGS when the NLP has none) and the MUMPS linear solver; the
-    constraint Jacobian and the Hessian are built point by point where the NLP has point calls
-    (ocpkit.solvers.pointwise: the same values, a fraction of the set-up), the dynamics rows' through point
-    derivatives compiled to C once per robot and machine unless `compiled` is False (ocpkit.solvers.compiled);
-    extra keyword options go to IPOPT verbatim (e.g. tol=1e-8). MUMPS starts without threshold pivoting
-    (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out inaccurate) and orders
-    the KKT system by approximate minimum fill (mumps_pivot_order 2, where MUMPS's automatic choice takes PORD),
-    both faster on our KKT systems. The barrier parameter stays below mu_max = 10⁻³ (IPOPT's default 10⁵): the
-    adaptive strategy otherwise falls back to a monotone barrier of ~0.1 on a slow iterate, which pushes a start
-    near a solution far from it: t_f up towards its bound, then slowly back (figures: docs/design-notes.md)."""
+    """IPOPT (interior point) with the exact Hessian by CasADi AD and the MUMPS linear solver.
+
+    L-BFGS stands in when the NLP has no exact Hessian. The constraint Jacobian and the Hessian are built point
+    by point where the NLP has point calls (ocpkit.solvers.pointwise: the same values, a cheaper set-up), the
+    dynamics rows' through point derivatives compiled to C once per robot and machine unless `compiled` is False
+    (ocpkit.solvers.compiled); extra keyword options go to IPOPT verbatim (e.g. tol=1e-8). MUMPS starts without
+    threshold pivoting (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out
+    inaccurate) and orders the KKT system by approximate minimum fill (mumps_pivot_order 2, where MUMPS's
+    automatic choice takes PORD), both faster on our KKT systems. The barrier parameter stays below mu_max = 10⁻³
+    (IPOPT's default 10⁵): the adaptive strategy otherwise falls back to a monotone barrier of ~0.1 on a slow
+    iterate, which pushes a start near a solution far from it: t_f up towards its bound, then slowly back
+    (figures: docs/design-notes.md)."""
 
     name = plugin = "ipopt"
     statuses = {
@@ -268,10 +270,9 @@ class SqpMethod(CasadiNlpsol):
     `convexify_strategy` ("regularize", "eigen-clip", "eigen-reflect") convexifies the Lagrangian Hessian:
     off (None) by default, as the paper cases converge without it, "regularize" stalls case 2 at the
     iteration limit and "eigen-clip" with osqp fails in the first QP. The time limit is checked between SQP
-    iterations, so one long QP (qpoases' first, cold-started, or one on a diverging iterate: 5–25 s on an
-    industrial6 problem at 12 knots) can overrun it; an iterate that leaves its bounds (after a failed QP) stops
-    the solve at once (module docstring). Extra keyword options go to
-    sqpmethod verbatim."""
+    iterations, so one long QP (qpoases' first, cold-started, or one on a diverging iterate; figures:
+    docs/design/moved-from-code.md) can overrun it; an iterate that leaves its bounds (after a failed QP) stops
+    the solve at once (module docstring). Extra keyword options go to sqpmethod verbatim."""
 
     name = plugin = "sqpmethod"
     statuses = {
@@ -295,7 +296,7 @@ class SqpMethod(CasadiNlpsol):
 
 
 class BlockSqp(CasadiNlpsol):
-    """blockSQP (Janka et al.) through CasADi: SQP with damped BFGS Hessian blocks and a filter line search.
+    """blockSQP (Janka et al.) via CasADi: SQP with damped BFGS Hessian blocks and a filter line search.
 
     Runs without HSL: CasADi's blockSQP defaults to qpOASES' Schur-complement QP, which needs the HSL
     `ma27` linear solver; we use the dense qpOASES QP (`schur` off, `linsol` "ldl"), which also means BFGS

@@ -3,8 +3,9 @@
 `compiled(functions)` generates their C (casadi.CodeGenerator), compiles it with the system C compiler ($CC, else
 `cc`) into a shared library kept in a disk cache named by the hash of the C, the compiler and its flags
 (~/.cache/ocpkit/compiled, or $XDG_CACHE_HOME/ocpkit/compiled; $OCPKIT_COMPILED_DIR overrides), and loads it
-with casadi.external: the same values as CasADi's virtual machine, several times faster. A library is written
-under a temporary name and renamed into place, so processes compiling the same C at once do not clash.
+with casadi.external: the same values as CasADi's virtual machine, evaluated faster (figures: docs/design-notes.md).
+A library is written under a temporary name and renamed into place, so processes compiling the same C at once do
+not clash.
 Without a compiler, or when a compile or the loading fails, there is nothing to load: None, with one warning.
 """
 
@@ -23,7 +24,8 @@ from pathlib import Path
 import casadi as ca
 
 FLAGS = ("-O1", "-fPIC", "-shared")
-"""-O1: ~4.5× CasADi's virtual machine on the dynamics derivatives; -O2 and -O3 compile longer for little more."""
+"""-O1: optimized code for a short compile; -O2 and -O3 compile longer for little faster code (figures:
+docs/design-notes.md)."""
 _warned: set[str] = set()
 _spent = 0.0  # seconds this process has spent compiling
 

@@ -12,14 +12,14 @@ turns into a constant), the starting point, and solves. An NLP lifted to MX arou
 
 Shared subexpressions: the .nl format stores expression trees, so a DAG node used twice is written twice
 unless it is a named Pyomo Expression (an .nl "defined variable"). Written as plain trees the dynamics blow
-the .nl file up by more than an order of magnitude, and writing it dominates; with every shared node (used more
-than once) named it stays small. ripopt, however, expands defined variables back into one tree per constraint
+the .nl file up many times over, and writing it dominates; with every shared node (used more than once) named
+it stays small. ripopt, however, expands defined variables back into one tree per constraint
 and takes its Hessian by one forward-over-reverse sweep per variable of that tree, so the dynamics
 constraints make every Hessian slow. So a shared node whose expanded tree exceeds `lift_above` nodes is
 lifted instead: an auxiliary Var `lifted[i]` with the equality `defines[i]` (lifted[i] == its expression),
 started at its value in the starting point; smaller shared nodes stay named Expressions. Lifting all shared
-nodes makes ripopt's KKT solves the bottleneck instead, so the default `lift_above` sits in between: it gave
-the fastest solves of the thresholds tried (docs/architecture.md, "Measured"). The lifted problem has the same
+nodes makes ripopt's KKT solves the bottleneck instead, so the default `lift_above` sits in between: it gives
+the fastest solves of the thresholds tried (figures: docs/design-notes.md). The lifted problem has the same
 solutions and the same multipliers of g. A lifted node that depends on fixed variables only (e.g. the
 dynamics at a rest knot) is fixed at its value for the query: left free, its defining equality has one free
 variable, and ripopt then could end "optimal" with that equality grossly violated.
@@ -32,8 +32,8 @@ output, which is captured, never printed; Pyomo's warnings are captured as well.
 
 Limits: `max_iterations` is ripopt's max_iter, `max_wall_time` (s) its max_wall_time, which ripopt checks
 between iterations (the .nl write comes before its clock starts). One iteration can take long (a diverging
-run can overrun the limit by more than the limit itself), so the ripopt process is also killed
-max(1 s, 1 %) after the limit (Pyomo's subprocess timeout): `time_limit` too, with the starting point.
+run can overrun the limit by far), so the ripopt process is also killed max(1 s, 1 %) after the limit (Pyomo's
+subprocess timeout): `time_limit` too, with the starting point.
 
 Multipliers: lam_g (n_g,) from the `dual` import Suffix; ripopt's constraint duals already follow CasADi's
 sign convention (checked against IPOPT in the tests); constraints the .nl writer drops (constant after
@@ -295,10 +295,12 @@ class PreparedRipopt(PreparedSolver):
 
 
 class PyomoRipopt(Solver):
-    """ripopt (interior point, exact Hessian by its own AD of the .nl expressions; L-BFGS when the NLP has no
-    second derivatives) on the NLP translated to Pyomo (see the module docstring). `lift_above` is the tree
-    size above which a shared subexpression becomes an auxiliary variable; `max_wall_time` is in seconds;
-    extra keyword options go to ripopt verbatim (e.g. tol=1e-8, mu_strategy="monotone")."""
+    """ripopt (interior point, exact Hessian by its own AD) on the NLP translated to a Pyomo model.
+
+    ripopt differentiates the .nl expressions itself, and takes L-BFGS when the NLP has no second derivatives
+    (see the module docstring). `lift_above` is the tree size above which a shared subexpression becomes an
+    auxiliary variable; `max_wall_time` is in seconds; extra keyword options go to ripopt verbatim (e.g.
+    tol=1e-8, mu_strategy="monotone")."""
 
     name = "pyomo"
 

@@ -136,8 +136,10 @@ class ScipyMinimize(Solver):
 
 
 class ScipySlsqp(ScipyMinimize):
-    """SciPy's SLSQP (Kraft): dense BFGS SQP; equalities and the finite sides of the inequalities as dense
-    constraint blocks. `ftol` (objective change) is its stopping tolerance."""
+    """SciPy's SLSQP (Kraft): a dense SQP with BFGS updates.
+
+    Equalities and the finite sides of the inequalities go in as dense constraint blocks. `ftol` (objective
+    change) is its stopping tolerance."""
 
     name, method = "scipy-slsqp", "SLSQP"
     statuses = {0: SolverStatus.CONVERGED, 4: SolverStatus.INFEASIBLE, 9: SolverStatus.ITERATION_LIMIT,
@@ -163,9 +165,11 @@ class ScipySlsqp(ScipyMinimize):
 
 
 class ScipyTrustConstr(ScipyMinimize):
-    """SciPy's trust-constr: trust-region interior point with the sparse constraint Jacobian and the exact
-    Hessians of f and of vᵀg (CasADi AD). `gtol`/`xtol` are its tolerances (on the Lagrangian gradient and
-    the trust radius); ending on either counts as converged, as SciPy itself reports it."""
+    """SciPy's trust-constr: a trust-region interior point with exact Hessians by CasADi AD.
+
+    It gets the sparse constraint Jacobian and the exact Hessians of f and of vᵀg. `gtol`/`xtol` are its
+    tolerances (on the Lagrangian gradient and the trust radius); ending on either counts as converged, as SciPy
+    itself reports it."""
 
     name, method = "scipy-trust-constr", "trust-constr"
     hessians = True

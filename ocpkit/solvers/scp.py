@@ -32,13 +32,13 @@ Every QP solved (second-order corrections included) counts towards `max_iteratio
 `max_wall_time` is checked before each QP (→ TIME_LIMIT); a QP solver failure → FAILED with its message.
 The result carries lam_g from the last QP's constraint duals (the ℓ1 QP's multipliers, |lam_g| ≤ ρ).
 
-Choices (each compared on the paper cases; the figures are in docs/architecture.md, "Measured"). Almost all
-of the time is spent in the QP solver.
+Choices (each compared on the paper cases; the figures are in docs/design-notes.md). The QP solver takes
+almost all of the time.
 - The QP is built once per NLP (in `prepare`) as a cvxpy Problem with Parameters (DPP), J and the Cholesky
   factor of H as *sparse* Parameters, so a QP is re-solved without canonicalizing it again; rebuilding it per
   QP costs more than the re-solve, and J as dense selection matrices times a Parameter vector of its nonzeros
   (the way without sparse Parameters) is slow to compile.
-- Clarabel over OSQP: OSQP needs thousands of ADMM iterations on the same QPs and still ends inaccurate.
+- Clarabel over OSQP: OSQP's ADMM needs far more iterations on the same QPs and still ends inaccurate.
   HiGHS rejects the semidefinite QP. Clarabel's `iterative_refinement_enable=False` (an extra option) is
   somewhat faster with unchanged results on the paper cases; the default keeps Clarabel's settings.
 - H = ∇²f: its diagonal alone needs more QPs; the Lagrangian Hessian made PSD by eigenvalue clipping (a
@@ -438,11 +438,13 @@ class PreparedScp(PreparedSolver):
 
 
 class SequentialConvex(Solver):
-    """Sequential convex programming with an ℓ1 penalty, box trust region and second-order corrections
-    (module docstring). `max_iterations` counts convex subproblems; `max_wall_time` is in seconds; `tol`
-    bounds the constraint violation and the relative predicted merit reduction at convergence; `qp_solver`
-    is a cvxpy solver name; `penalty` is the initial ρ, `max_penalty` its cap, `trust_radius` the initial Δ
-    (relative to the scale s); extra keyword options go to cvxpy's `solve` (the QP solver's settings)."""
+    """Sequential convex programming (TrajOpt style): an ℓ1 penalty and a box trust region.
+
+    Second-order corrections keep good steps (see the module docstring). `max_iterations` counts convex
+    subproblems; `max_wall_time` is in seconds; `tol` bounds the constraint violation and the relative predicted
+    merit reduction at convergence; `qp_solver` is a cvxpy solver name; `penalty` is the initial ρ,
+    `max_penalty` its cap, `trust_radius` the initial Δ (relative to the scale s); extra keyword options go to
+    cvxpy's `solve` (the QP solver's settings)."""
 
     name = "scp"
 

@@ -13,7 +13,7 @@ against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP 
   mesh interval), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f never divides;
 - the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base),
   through one CasADi Function per constraint of a symbolic point, made once and inlined at every point (running a
-  constraint's Python code point by point was most of the graph construction time);
+  constraint's Python code point by point makes graph construction slow);
 - the OCP's rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) = 0), also
   through one Function of a symbolic node where the dynamics backend is symbolic (exact second derivatives);
 - a record of those point Functions' rows (`NLP.point_calls`), from which IPOPT's derivatives are built point by

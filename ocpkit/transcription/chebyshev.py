@@ -16,8 +16,9 @@ from ocpkit.transcription.pseudospectral import Pseudospectral
 
 
 class Chebyshev(Pseudospectral):
-    """Chebyshev pseudospectral transcription with N = `knots` intervals (N + 1 Chebyshev–Lobatto points) on
-    each of `segments` equal segments."""
+    """Chebyshev pseudospectral transcription on Chebyshev–Lobatto points, in one or more equal segments.
+
+    N = `knots` intervals (N + 1 Chebyshev–Lobatto points) on each of `segments` equal segments."""
 
     name = "chebyshev"
     family = CHEBYSHEV

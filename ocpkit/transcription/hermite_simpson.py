@@ -57,8 +57,9 @@ class HermiteSimpsonDiscretization(MeshDiscretization):
 
 
 class HermiteSimpson(MeshTranscription):
-    """Hermite–Simpson collocation (Kelly 2017, separated form) with N = `knots` intervals, N + 1 knots and
-    N midpoints."""
+    """Hermite–Simpson collocation (Kelly 2017, separated form) on a uniform mesh, with interval midpoints.
+
+    N = `knots` intervals, N + 1 knots and N midpoints."""
 
     name = "hermite-simpson"
     discretization = HermiteSimpsonDiscretization

@@ -45,8 +45,9 @@ LGL = NodeFamily("Legendre–Gauss–Lobatto", lgl_points, lgl_barycentric_weigh
 
 
 class LegendreGaussLobatto(Pseudospectral):
-    """LGL pseudospectral transcription with N = `knots` intervals (N + 1 LGL points) on each of `segments`
-    equal segments."""
+    """Legendre–Gauss–Lobatto (LGL) pseudospectral transcription, in one or more equal segments.
+
+    N = `knots` intervals (N + 1 LGL points) on each of `segments` equal segments."""
 
     name = "lgl"
     family = LGL

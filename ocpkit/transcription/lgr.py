@@ -64,8 +64,10 @@ LGR = NodeFamily("Legendre–Gauss–Radau", lgr_points, lgr_barycentric_weights
 
 
 class LegendreGaussRadau(Pseudospectral):
-    """LGR pseudospectral transcription (as in GPOPS-II and dymos) with N = `knots` intervals (N LGR points and
-    the non-collocated end) on each of `segments` equal segments: D X = h F at every point but t_f."""
+    """Legendre–Gauss–Radau (LGR) pseudospectral transcription, as in GPOPS-II and dymos.
+
+    N = `knots` intervals (N LGR points and the non-collocated end) on each of `segments` equal segments:
+    D X = h F at every point but t_f."""
 
     name = "lgr"
     family = LGR

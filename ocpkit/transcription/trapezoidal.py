@@ -44,7 +44,9 @@ class TrapezoidalDiscretization(MeshDiscretization):
 
 
 class Trapezoidal(MeshTranscription):
-    """Trapezoidal collocation (Kelly 2017) with N = `knots` intervals, N + 1 knots."""
+    """Trapezoidal collocation (Kelly 2017) on a uniform mesh.
+
+    N = `knots` intervals, N + 1 knots."""
 
     name = "trapezoidal"
     discretization = TrapezoidalDiscretization

@@ -37,9 +37,15 @@ def test_list_prints_every_registry_group_with_its_components(capsys):
     lines = capsys.readouterr().out.splitlines()
     headings = [line for line in lines if not line.startswith(" ")]
     assert headings == list(GROUPS)
-    names = {line.split()[0] for line in lines if line.startswith("  ")}
+    components = [line for line in lines if line.startswith("  ")]
+    names = {line.split()[0] for line in components}
     assert {"chebyshev", "casadi-rnea", "collision", "torque-rate", "ipopt", "simultaneous", "ompl-toppra",
             "line"} <= names
+    # one line each: the docstring's first sentence, cut with "…" to fit the line
+    assert all(len(line) <= 120 for line in components), max(components, key=len)
+    assert all(line.endswith((".", "…")) for line in components)
+    assert ("  ipopt             IPOPT (interior point) with the exact Hessian by CasADi AD and the MUMPS linear "
+            "solver.") in components
 
 
 def test_list_gives_each_constraint_its_docstring_line(capsys):
