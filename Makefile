@@ -1,10 +1,11 @@
 # `make demo`: the paper benchmark table.  `make test`: the whole test suite (CI runs exactly this).
+# `make docs`: the documentation site in site/ (mkdocs build --strict).
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= results/paper
 
-.PHONY: demo test clean chromium compiler
+.PHONY: demo test docs clean chromium compiler
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -20,6 +21,10 @@ demo: $(VENV)/.installed compiler
 test: $(VENV)/.installed chromium compiler
 	$(BIN)/python -m pytest -q
 
+# The test extras include the docs packages (tests/test_docs.py builds the site too).
+docs: $(VENV)/.installed
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site
+
 # The report and viewer tests take screenshots with headless Chromium (Debian's package; installed as root).
 chromium:
 	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || { [ "$$(id -u)" = 0 ] && \
@@ -34,4 +39,4 @@ compiler:
 		echo "no C compiler: the dynamics derivatives run uncompiled (slower); apt-get install gcc"
 
 clean:
-	rm -rf $(VENV) results
+	rm -rf $(VENV) results site

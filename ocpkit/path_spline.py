@@ -5,7 +5,7 @@ c (rad): p‴ = p⁗ = 0 at both ends, which makes it the interpolant of least �
 is s = c / L (L the chord length of the whole path). Rest at both ends is the timing's (ṡ = s̈ = 0 gives
 q̇ = q̈ = 0), so the path keeps its tangent there: with p′ = 0 at the ends (a clamped spline, what TOPP-RA needs)
 the path speed would vanish in s and the timing OCP would need ṡ → ∞ near the ends, which its polynomials
-represent badly (README, "ompl-topp3").
+represent badly (docs/concepts/baselines.md, "ompl-topp3").
 Both evaluations use one piecewise polynomial in s (the spline's own Taylor coefficients at every breakpoint):
 `values` in NumPy, `symbolic` on CasADi symbols for s, the breakpoints and the coefficients (the interval
 selected by comparisons, so the expression is exact wherever s is; the breakpoints and coefficients are NLP

@@ -1,4 +1,4 @@
-"""Suite files of `ocpkit bench run`: scenario sources × a grid of methods × repeats (README, 'Benchmark suites').
+"""Suite files of `ocpkit bench run`: scenario sources × a grid of methods × repeats (docs/formats.md, 'Suite files').
 
 A suite is checked with the project schema (ocpkit.formats.schema; errors name the field, e.g. `methods[1].knots`),
 every scenario is loaded and validated, and every method's options are checked against its planner, all before
@@ -269,7 +269,7 @@ def _method(data: dict, where: str) -> Method:
             raise SuiteError(f"{where}.{key}: planner {planner!r} takes no option {key!r}; its options: "
                              f"{', '.join(taken)}")
     if "planner_name" in options:
-        from ocpkit.baselines.ompl_toppra import OMPL_PLANNERS
+        from ocpkit.planner.ompl_seed import OMPL_PLANNERS
 
         if options["planner_name"] not in OMPL_PLANNERS:
             raise SuiteError(f"{where}.planner_name: unknown OMPL planner {options['planner_name']!r}; known: "

@@ -11,8 +11,8 @@ from ocpkit.errors import OptionError
 
 def add_run_arguments(bench: argparse.ArgumentParser) -> None:
     """The options of `ocpkit bench run SUITE.yaml` on the `bench` parser."""
-    bench.add_argument("suite_file", nargs="?", metavar="SUITE.yaml", help="run: the suite file (README, "
-                       "'Benchmark suites')")
+    bench.add_argument("suite_file", nargs="?", metavar="SUITE.yaml", help="run: the suite file (docs/formats.md, "
+                       "'Suite files')")
     bench.add_argument("--jobs", type=int, default=1, help="run: local worker processes (default 1); --repeats "
                        "overrides the suite's repeats")
     bench.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run: run the tasks on this Dask "

@@ -7,7 +7,7 @@ Read: `world.collision_objects` (boxes, spheres and cylinders; each primitive's 
 tolerances, other joints, planner settings, the allowed-collision matrix, ...) is listed in `Conversion.ignored`.
 Poses are taken in the world frame whatever `header.frame_id` says (noted when it names another frame).
 Positions are `[x, y, z]` or `{x, y, z}`, orientations `[x, y, z, w]` or `{x, y, z, w}` (both forms occur).
-The scenario gets no workspace box and the loader's own time and cost defaults (README, 'MoveIt import').
+The scenario gets no workspace box and the loader's own time and cost defaults (docs/robots-and-data.md, 'MoveIt scenes').
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ OBJECT_KEYS_READ = ("id", "header", "pose", "primitives", "primitive_poses", "op
 
 @dataclass(frozen=True)
 class Conversion:
-    """A scenario mapping (radians, README 'Scenario files') and one line per MoveIt item left out of it."""
+    """A scenario mapping (radians, docs/formats.md 'Scenario files') and one line per MoveIt item left out of it."""
 
     scenario: dict[str, Any]
     ignored: tuple[str, ...]

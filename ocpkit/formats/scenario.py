@@ -1,4 +1,4 @@
-"""Load and validate scenario YAML files (format in README, section 'Scenario files'; schema in ocpkit.formats.schema)
+"""Load and validate scenario YAML files (format in docs/formats.md, 'Scenario files'; schema in ocpkit.formats.schema)
 into a Problem.
 
 Defaults: scene empty, time.min 0.1 s, time.max 10 s, time.guess min(10 s, time.max) but never below time.min,

@@ -340,7 +340,7 @@ SCENARIO = Mapping(
     optional={"name": String(), "scene": Mapping(optional={"obstacles": Sequence(OBSTACLE), "workspace": WORKSPACE}),
               "time": TIME, "cost": COST},
 )
-"""A scenario file (README, 'Scenario files'); start and goal have the robot's n values (checked on loading)."""
+"""A scenario file (docs/formats.md, 'Scenario files'); start and goal have the robot's n values (checked on loading)."""
 
 SPEC = Mapping(
     required={
@@ -363,4 +363,4 @@ SPEC = Mapping(
         "base": Mapping(optional={"xyz": vector(length=3), "rpy": vector(length=3)}),
     },
 )
-"""A robot spec.yaml (README, 'Robot files'); every vector has one value per joint (checked on loading)."""
+"""A robot spec.yaml (docs/formats.md, 'Robot files'); every vector has one value per joint (checked on loading)."""

@@ -52,7 +52,7 @@ def time_excess(tf: float, lower: float, upper: float) -> float:
 
 def write_json(path: str | Path, trajectory: Trajectory, header: dict[str, Any], dt: float = 1e-3, *,
                time_bounds: tuple[float, float] | None = None, max_samples: int = MAX_SAMPLES) -> None:
-    """Write the exchange format (README, 'Trajectory files'): header fields, knots and dt-spaced samples.
+    """Write the exchange format (docs/formats.md, 'Trajectory files'): header fields, knots and dt-spaced samples.
 
     `header` holds robot, joint_names, method, status, solve_time_s and iterations. The samples are left out
     (`"samples": null`, and `"samples_omitted"` says why) when t_f is not finite, lies outside `time_bounds`

@@ -1,4 +1,4 @@
-"""`ocpkit robot import`: a spec.yaml for any URDF (README, section 'Robots from any URDF').
+"""`ocpkit robot import`: a spec.yaml for any URDF (docs/robots-and-data.md, 'Robots from any URDF').
 
 Limits come from the URDF's `<limit>` (position, velocity, effort). Where the URDF knows nothing, a documented
 rule fills in, and `overrides` replace any value:

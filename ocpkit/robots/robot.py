@@ -105,7 +105,7 @@ _BY_KEY: dict[str, Robot] = {}
 
 
 def robot_from_files(urdf: Path, spec_file: Path) -> Robot:
-    """Build a Robot from a URDF and a spec.yaml (README, section 'Robot files'; ocpkit.formats.schema.SPEC).
+    """Build a Robot from a URDF and a spec.yaml (docs/formats.md, 'Robot files'; ocpkit.formats.schema.SPEC).
 
     Both files are read anew on every call; identical content gives the same Robot object (a bounded cache by
     content key), so problems on one robot share one Robot and its builds, and an edited file a new Robot."""
