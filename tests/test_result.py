@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import types
 
 import numpy as np
@@ -12,10 +13,19 @@ from helpers import REPO, monomial, polynomial_motion
 import ocpkit
 from ocpkit import result as result_module
 from ocpkit.errors import OptionError, ScenarioError
+from ocpkit.formats.record import Recorded, result_row
 from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Scene
 from ocpkit.planner import PLANNERS
-from ocpkit.result import finish
+from ocpkit.result import (
+    PathStats,
+    PlanStats,
+    RungRow,
+    Screening,
+    SolveTiming,
+    Timing,
+    finish,
+)
 from ocpkit.verify import Check, Verification
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -67,6 +77,62 @@ def test_solve_time_excludes_the_setup_time(motion, clock):
 
 def test_stats_extra_defaults_to_an_empty_dict(motion, clock):
     assert finish(FREE, motion, None, {}, 10.0, verification=PASSED).stats.extra == {}
+
+
+ROUND = SolveTiming(0.12, 0.01, 27, {"nlp_f": 0.002, "total": 0.11})
+
+
+def test_the_simultaneous_planners_figures_keep_their_json_shape(motion):
+    timing = Timing(guess=0.01, setup={"graph": 0.1, "solver": 0.6, "compile": 0.0}, rounds=(ROUND, ROUND))
+    stats = finish(FREE, motion, None, {}, 0.0, timing=timing, screening=Screening(8, 0), verification=PASSED).stats
+    assert stats.figures() == {
+        "timing": {"guess": 0.01, "rounds": [{"solve": 0.12, "verify": 0.01, "iterations": 27, "nlp_f": 0.002,
+                                              "total": 0.11}] * 2, "setup": {"graph": 0.1, "solver": 0.6,
+                                                                             "compile": 0.0}},
+        "screening": {"rows_per_point": 8, "rebuilds": 0}}
+    assert (timing.solve, timing.verify, timing.refinement) == pytest.approx((0.24, 0.02, 0.13))
+    ladder = dataclasses.replace(stats, rungs=(RungRow("first", "violated", 0.281, 27),), skipped=("uncapped",),
+                                 hint="try this")
+    assert ladder.figures()["rungs"] == [{"rung": "first", "status": "violated", "time_s": 0.281, "iterations": 27}]
+    assert (ladder.figures()["skipped"], ladder.figures()["hint"]) == (["uncapped"], "try this")
+
+
+def test_a_baselines_figures_keep_their_flat_keys(motion):
+    timing = Timing(path_search=0.2, simplify=0.05, smooth=0.0, path_timing=0.0)
+    stats = finish(FREE, motion, "no_path", {}, 0.0, timing=timing, path=PathStats(4240, 0, 0, 0.01),
+                   verification=PASSED, found=False).stats
+    assert stats.figures() == {"path_time_s": 0.2, "simplify_time_s": 0.05, "smooth_time_s": 0.0,
+                               "toppra_time_s": 0.0, "validity_checks": 4240, "waypoints": 0, "repair_rounds": 0,
+                               "margin_m": 0.01}
+    timed = dataclasses.replace(stats, path=PathStats(4240, 3, 1, 0.01, toppra_tf=0.9), extra={"own": "x"})
+    assert (timed.figures()["toppra_tf_s"], timed.figures()["own"]) == (0.9, "x")
+    assert PlanStats(1.0, 0.0, 0, 0, "").figures() == {}
+
+
+def test_a_planners_hint_is_the_plans_hint(motion):
+    result = finish(FREE, motion, "infeasible", {}, 0.0, verification=PASSED)
+    assert "locally infeasible" in result.hint
+    hinted = dataclasses.replace(result, stats=dataclasses.replace(result.stats, hint="the planner's own word"))
+    assert hinted.hint == "the planner's own word"
+
+
+OLD_EXTRA = ('{"timing": {"guess": 0.0128, "rounds": [{"solve": 0.121, "verify": 0.0094, "iterations": 27, '
+             '"nlp_f": 0.0002, "total": 0.120}], "setup": {"graph": 0.137, "solver": 0.676, "compile": 0.0}}, '
+             '"screening": {"rows_per_point": 8, "rebuilds": 0}, "rungs": [{"rung": "first", "status": "verified", '
+             '"time_s": 0.281, "iterations": 27}], "skipped": []}')
+
+
+def test_a_results_row_reads_back_old_and_new(motion):
+    stats = finish(FREE, motion, None, {"planner": "simultaneous"}, 0.0, iterations=27,
+                   timing=Timing(guess=0.01, rounds=(ROUND,)), screening=Screening(8, 0), verification=PASSED).stats
+    result = finish(FREE, motion, None, {"planner": "simultaneous"}, 0.0, verification=PASSED)
+    row = result_row("paper", "case2", dataclasses.replace(result, stats=stats), 0.2, 0.8)
+    recorded = Recorded.of({k: str(v) for k, v in row.items()})
+    assert recorded.extra == json.loads(json.dumps(stats.figures())) and recorded.iterations == 27
+    old = {**row, "extra": OLD_EXTRA}
+    assert Recorded.of(old).extra["rungs"][0]["time_s"] == 0.281
+    assert set(Recorded.of(old).extra["timing"]) == set(recorded.extra["timing"]) == {"guess", "rounds", "setup"}
+    assert Recorded.of({**row, "extra": ""}).extra == {}
 
 
 @pytest.fixture

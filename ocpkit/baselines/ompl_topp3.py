@@ -1,16 +1,16 @@
 """`ompl-topp3`: the decomposition baseline held to the simultaneous planner's limits and cost.
 
-1. The OMPL path exactly as `ompl-toppra` finds it (ompl_toppra.py: same validity checker, planner, seed and
-   shortcutting).
+1. The OMPL path exactly as `ompl-toppra` finds it (ocpkit.planner.ompl_seed: same validity checker, planner,
+   seed and shortcutting).
 2. Made smooth to its third derivative: the natural quintic spline in the chord length (`PathSpline`), re-checked
-   densely and repaired by ompl_toppra's `_smooth_path` (half the margin every resolution/4 rad, and the joint
+   densely and repaired by the seed's `smooth_path` (half the margin every resolution/4 rad, and the joint
    position limits, which the timing cannot change). Its parameter is normalised: q = p(s), s ∈ [0, 1].
 3. The timing along that fixed path as an optimal control problem in s (`PathTimingOCP`): s(t) from rest at 0 to
    rest at 1, q̇ = p′ṡ, q̈ = p′s̈ + p″ṡ², q⃛ = p′s⃛ + 3p″ṡs̈ + p‴ṡ³, τ = RNEA(q, q̇, q̈) + friction; the
    velocity, torque and torque-rate limits and the cost t_f + μ∫q⃛ᵀQq⃛ dt of the simultaneous planner. It is
    transcribed and solved by ocpkit's own transcriptions and solvers (the same arguments as
    `plan_simultaneous`: transcription, knots, dynamics, solver, ...), solved with the same refinement rounds,
-   warm-started from the TOPP-RA profile of the same path (`_time_optimal`; where TOPP-RA cannot time it, from
+   warm-started from the TOPP-RA profile of the same path (`time_optimal`; where TOPP-RA cannot time it, from
    s moving at constant speed over time.guess, `PathTimingOCP.guess`). The path enters the NLP as
    parameters, its pieces split up to a multiple of PIECES_STEP, so paths share one build (the build cache's,
    like the simultaneous planner's shapes) and its one-time set-up is not computation.
@@ -21,29 +21,30 @@ The motion returned is q(t) = p(s(t)) at every sample, so it stays on the checke
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from ocpkit.baselines.ompl_toppra import (
-    MAX_STEP,
-    _hold,
-    _import_backends,
-    _no_path,
-    _ompl_path,
-    _smooth_path,
-    _time_optimal,
-    check_ompl_planner,
-    planning_space,
-)
 from ocpkit.dynamics import Dynamics
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import PathSpline
 from ocpkit.planner.build_cache import build
+from ocpkit.planner.ompl_seed import (
+    MAX_STEP,
+    check_ompl_planner,
+    hold,
+    import_backends,
+    no_path_message,
+    ompl_path,
+    planning_space,
+    smooth_path,
+    time_optimal,
+)
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, Refined, solve_refined
 from ocpkit.problem import Problem
-from ocpkit.result import Plan, finish
+from ocpkit.result import PathStats, Plan, Timing, finish
 from ocpkit.solvers import SolverStatus
 from ocpkit.transcription.ocp import PathTimingOCP
 
@@ -108,7 +109,7 @@ def time_path(problem: Problem, smooth: PathSpline, transcription: str = "chebys
     """The optimal timing of the fixed path `smooth` (from problem.start to problem.goal) under `problem`'s limits
     and cost (the module docstring's step 3; options as for `plan_ompl_topp3`)."""
     path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
-    timed = _time_optimal(problem, ToppraPath(path), grid_points)
+    timed = time_optimal(problem, ToppraPath(path), grid_points)
     ocp = PathTimingOCP(problem.robot, path)
     made = build(problem, transcription, knots, dynamics, solver, TIMING_CONSTRAINTS, transcription_options,
                  solver_options, dynamics_options, ocp=ocp)
@@ -145,22 +146,26 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     method = {"planner": "ompl-topp3", "path_planner": planner_name, "transcription": transcription, "knots": knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": solver}
     if np.array_equal(problem.start, problem.goal):
-        return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
-    setup = _import_backends()
+        return finish(problem, hold(problem), None, method, began, message="the goal is the start: hold still")
+    setup = import_backends()
     free = planning_space(problem, margin)
-    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
-    extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "margin_m": free.margin}
+    found = ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
+    searched = Timing(path_search=found.path_time, simplify=found.simplify_time)
     if found.waypoints is None:
-        return finish(problem, _hold(problem), "no_path", method, began, setup_time=setup, extra=extra, found=False,
-                      message=f"{_no_path(planner_name, planning_time, free)}; the plan holds the start")
-    smooth, rounds = _smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
+        return finish(problem, hold(problem), "no_path", method, began, setup_time=setup, timing=searched,
+                      path=PathStats(free.checks, 0, 0, free.margin), found=False,
+                      message=f"{no_path_message(planner_name, planning_time, free)}; the plan holds the start")
+    smoothing = time.perf_counter()
+    smooth, rounds = smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
+    smoothed = time.perf_counter()
     timing = time_path(problem, smooth, transcription, knots, dynamics, solver, refinements, transcription_options,
                        solver_options, dynamics_options, max_wall_time, grid_points)
     refined, result = timing.refined, timing.refined.result
-    extra.update(waypoints=len(found.waypoints), repair_rounds=rounds, toppra_tf_s=timing.toppra_tf)
+    spent = dataclasses.replace(searched, smooth=smoothed - smoothing, rounds=refined.timing)
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; timing {timing.start}: "
                f"{result.message}")
     return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + timing.setup_time,
-                  iterations=refined.iterations, rounds=refined.rounds, message=message, extra=extra,
+                  iterations=refined.iterations, rounds=refined.rounds, message=message, timing=spent,
+                  path=PathStats(free.checks, len(found.waypoints), rounds, free.margin, timing.toppra_tf),
                   verification=refined.verification)

@@ -1,436 +1,50 @@
 """The path–velocity decomposition baseline: an OMPL joint-space path, made smooth, then timed by TOPP-RA.
 
 The classic alternative to planning path and timing together, on the same problems and checked by the same
-dense `verify`. Each step is one function below:
-
-1. `FreeSpace`: OMPL's validity test is the verifier's own collision model (`geometry.sphere_centers`,
-   `geometry.clearances`: robot spheres against each other, the obstacle spheres and the workspace box):
-   a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
-   The joint limits are the state-space bounds.
-2. `_ompl_path`: RRTConnect (or RRT*, BIT*, PRM) in joint space. A straight segment is checked, batched, at
-   configurations at most `resolution` rad apart (Euclidean over the joints). An RRT extends at most `max_step`
-   rad at a time (MAX_STEP; OMPL's own default, a fifth of the joint box's diagonal, is 2.6 rad on the Panda and
-   6.2 rad on the UR5, and such long extensions into a cage or a shelf mostly fail). OMPL's PathSimplifier then
-   shortens the path until it stops improving.
-3. `_smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
-   tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
-   obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
-4. `_time_optimal`: TOPP-RA on `grid_points` path points, with joint velocity limits and joint torque limits
-   tau = rnea(q, qd, qdd) + friction(qd).
-5. `_TimedPath`: the resulting trajectory q(t) = path(s(t)), and the torque it takes.
-
-Choices and what they cost, stated plainly:
-
-- Zero end tangents ('clamped'). Along a path, qdd = q'(s) s̈ + q''(s) ṡ². The problem asks for rest at both
-  ends, qd = qdd = 0, and a time-optimal s̈ is not zero at the ends. So only a path with q'(0) = q'(1) = 0
-  starts and stops with qdd = 0. A 'natural' spline gives qdd(0) = q'(0) s̈(0) ≠ 0 and fails the boundary check.
-- Constant s̈ between grid points (toppra's ParametrizeConstAccel, not its default spline refit). The motion
-  stays exactly on the collision-checked path, and the limits hold where TOPP-RA imposed them. The default
-  refits a spline in time through the grid points: it leaves the path between them and does not stop with
-  qdd = 0 (on the paper cases it ends far from rest, failing the boundary check).
-- Friction. TOPP-RA's constraints are linear in (s̈, ṡ²). The friction law viscous·qd + coulomb·tanh(qd/ε)
-  depends on ṡ, so it enters as toppra's path-dependent term, evaluated at an assumed speed profile. The
-  first pass assumes every moving joint is at its velocity limit (the largest friction). The second pass
-  uses the speed the first pass found (`FRICTION_PASSES`). The friction is then right at the grid points to
-  the extent the profile stopped changing. `verify` checks the exact model.
-- Limits hold on TOPP-RA's grid: at both ends of every grid interval, for the velocity at the grid points.
-  Between grid points the path's curvature changes slightly, so `grid_points` must be large enough.
-- TOPP-RA cannot bound torque rate or jerk. The time-optimal s̈ is bang–bang and piecewise constant on the
-  grid, so the torque jumps. The torque rate reported is the mean rate over a `TORQUE_RATE_WINDOW` (1 ms)
-  window centred at t: the derivative where the torque is smooth, and J / 1 ms across a jump J, which is
-  what a 1 kHz servo loop would have to follow. The baseline normally fails the torque-rate check; the plan
-  says so in its status ("violated").
-
-OMPL and toppra are optional dependencies, imported on first use (toppra is slow to import).
+dense `verify`: the OMPL seed's motion (ocpkit.planner.ompl_seed, where each step and its costs are described),
+verified as a plan. TOPP-RA cannot bound the torque rate, so the baseline normally fails the torque-rate check;
+the plan says so in its status ("violated").
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from dataclasses import dataclass, replace
-from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
-from ocpkit.errors import NoGuess, OptionError, RegistryError
-from ocpkit.formats.trajectory import Samples, Trajectory
-from ocpkit.geometry.clearances import clearances, sphere_centers
+from ocpkit.planner.ompl_seed import (
+    MAX_STEP,
+    SeedOptions,
+    hold,
+    ompl_path,
+    ompl_seed,
+    planning_space,
+)
 from ocpkit.problem import Problem
 from ocpkit.result import Plan, finish
-from ocpkit.robots import Robot, rigid_torque
-from ocpkit.transcription import Discretization
-
-OMPL_PLANNERS = {"rrtconnect": "RRTConnect", "rrtstar": "RRTstar", "bitstar": "BITstar", "prm": "PRM"}
-REPAIR_ROUNDS = 8
-FRICTION_PASSES = 2
-TORQUE_RATE_WINDOW = 1e-3  # s
-MAX_STEP = 1.0  # rad: an RRT's longest extension (OMPL's `range`; module docstring, figures in README.md)
-GUESS_SLOWDOWN = 1.5  # the OMPL guess's motion takes this many times TOPP-RA's time (`ompl_guess`)
-SEGMENT_BATCH = 16  # configurations in the first batch checked along a segment; later batches double
-
-
-class FreeSpace:
-    """The verifier's collision model as a yes/no test: free iff every clearance is ≥ `margin` (m).
-
-    Keeps one pinocchio Data and counts the configurations it has checked (`checks`)."""
-
-    def __init__(self, problem: Problem, margin: float) -> None:
-        self.robot, self.scene, self.margin = problem.robot, problem.scene, margin
-        self.data = problem.robot.model.createData()
-        self.checks = 0
-
-    def clearance(self, q: np.ndarray) -> np.ndarray:
-        """Smallest clearance (m) at each configuration of q (K, n): shape (K,); +inf if there is nothing to hit."""
-        c = clearances(self.robot, self.scene, sphere_centers(self.robot, q, self.data))
-        self.checks += len(q)
-        flat = [values.reshape(len(q), -1) for values in (c.self_pairs, c.obstacles, c.workspace)]
-        return np.concatenate(flat, axis=1).min(axis=1, initial=np.inf)
-
-    def free(self, q: np.ndarray) -> np.ndarray:
-        """Whether each configuration of q (K, n) keeps the margin: shape (K,), bool."""
-        return self.clearance(q) >= self.margin
-
-    def segment_free(self, a: np.ndarray, b: np.ndarray, resolution: float) -> bool:
-        """Whether the straight segment a → b (n,) is free at configurations at most `resolution` rad apart.
-
-        b is checked, a is not (OMPL has already checked it). The configurations are checked coarse to fine,
-        in batches that double in size, so a collision usually stops the check after the first batch."""
-        count = max(int(np.ceil(np.linalg.norm(b - a) / resolution)), 1)
-        order = _coarse_to_fine(count) / count
-        done, size = 0, SEGMENT_BATCH
-        while done < count:
-            if not self.free(a + np.outer(order[done:done + size], b - a)).all():
-                return False
-            done, size = done + size, 2 * size
-        return True
-
-
-def _coarse_to_fine(count: int) -> np.ndarray:
-    """The indices 1..count: count first, then the others by decreasing power of two dividing them."""
-    inner = np.arange(1, count)
-    return np.concatenate([[count], inner[np.argsort(-(inner & -inner), kind="stable")]])
-
-
-def check_ompl_planner(planner_name: str) -> None:
-    """RegistryError unless `planner_name` is one of OMPL_PLANNERS."""
-    if planner_name not in OMPL_PLANNERS:
-        raise RegistryError(f"unknown OMPL planner {planner_name!r}; known: {', '.join(OMPL_PLANNERS)}")
-
-
-def planning_space(problem: Problem, margin: float) -> FreeSpace:
-    """The FreeSpace OMPL plans in: `margin` (m), lowered to half the start's or goal's clearance if that is
-    smaller, as the transcriptions lower theirs (a margin as wide as an end's clearance would leave no room to
-    leave it)."""
-    return FreeSpace(problem, min(margin, 0.5 * problem.end_clearances.smallest()))
-
-
-# -- OMPL ---------------------------------------------------------------------------------------------
-
-
-@contextmanager
-def _ompl_log_level(util: Any, level: Any) -> Iterator[None]:
-    """Run a block at OMPL log `level`, then restore the previous level."""
-    previous = util.getLogLevel()
-    util.setLogLevel(level)
-    try:
-        yield
-    finally:
-        util.setLogLevel(previous)
-
-
-def _seed_ompl(util: Any, seed: int) -> None:
-    """Seed OMPL's RNG with seed + 1 (OMPL rejects 0). Every RNG created afterwards (planner, sampler,
-    simplifier) then draws from it, so a run repeats exactly. OMPL logs an error when it is re-seeded after
-    first use, although the new seed does take effect; that message is silenced."""
-    with _ompl_log_level(util, util.LOG_NONE):
-        util.RNG.setSeed(seed + 1)
-
-
-def _space_information(problem: Problem, free: FreeSpace, resolution: float) -> Any:
-    """OMPL's joint space: the joint limits as bounds, `free` as the state validity checker, and straight
-    segments checked by `free.segment_free` at `resolution` rad."""
-    import ompl.base as ob
-
-    robot, n = problem.robot, problem.robot.n
-    space = ob.RealVectorStateSpace(n)
-    bounds = ob.RealVectorBounds(n)
-    bounds.low, bounds.high = robot.q_lower.tolist(), robot.q_upper.tolist()
-    space.setBounds(bounds)
-    si = ob.SpaceInformation(space)
-
-    class SegmentValidator(ob.MotionValidator):
-        def checkMotion(self, a: Any, b: Any) -> bool:  # noqa: N802  (OMPL's name)
-            return free.segment_free(_vector(a, n), _vector(b, n), resolution)
-
-    si.setStateValidityChecker(lambda state: bool(free.free(_vector(state, n)[None])[0]))
-    si.setMotionValidator(SegmentValidator(si))
-    si.setup()
-    return si
-
-
-def _vector(state: Any, n: int) -> np.ndarray:
-    """An OMPL real-vector state as an array (n,)."""
-    return np.array(state[0:n])
-
-
-def _state(si: Any, q: np.ndarray) -> Any:
-    """A new OMPL state holding q (n,), clipped into the joint limits (scenario files allow 1e-9 rad of round-off)."""
-    bounds = si.getStateSpace().getBounds()
-    state = si.allocState()
-    state[0:len(q)] = np.clip(q, bounds.low, bounds.high).tolist()
-    return state
-
-
-def _termination(ob: Any, free: FreeSpace, planning_time: float, max_checks: int | None) -> Any:
-    """OMPL's termination condition: `planning_time` s passed (not with inf, which OMPL's timer cannot take) or
-    more than `max_checks` configurations checked by `free` (not with None)."""
-    if max_checks is None:
-        return ob.timedPlannerTerminationCondition(planning_time)
-    budget = ob.PlannerTerminationCondition(lambda: free.checks > max_checks)
-    if np.isinf(planning_time):
-        return budget
-    return ob.plannerOrTerminationCondition(ob.timedPlannerTerminationCondition(planning_time), budget)
-
-
-@dataclass(frozen=True)
-class _OmplResult:
-    """Simplified waypoints (k, n) from start to goal, or None without an exact path; times in seconds."""
-
-    waypoints: np.ndarray | None
-    path_time: float
-    simplify_time: float
-
-
-def _ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
-               resolution: float, max_checks: int | None = None, max_step: float | None = MAX_STEP) -> _OmplResult:
-    """Plan start → goal with the named OMPL planner (RRTs extending at most `max_step` rad) until it stops with an
-    exact path, `planning_time` seconds have passed or (if given) `free` has checked more than `max_checks`
-    configurations, then simplify the path to convergence. A budget in checks repeats on any machine; one in seconds
-    does not.
-
-    The time budget is OMPL's own timer. A check budget is a Python condition, safe only for planners that plan in
-    the calling thread (RRTConnect, RRT*, BIT*): PRM checks for a solution in a second thread, which would deadlock
-    waiting for the interpreter lock that the planning thread holds."""
-    import ompl.base as ob
-    import ompl.geometric as og
-    import ompl.util as ou
-
-    if max_step is not None and not (np.isfinite(max_step) and max_step > 0):
-        raise OptionError(f"max_step must be a finite number of radians > 0, got {max_step}")
-    if max_checks is not None and planner_name == "prm":
-        raise OptionError("max_checks cannot stop prm (it plans in a second thread); give it a planning_time")
-    with _ompl_log_level(ou, ou.LOG_ERROR):
-        _seed_ompl(ou, seed)
-        si = _space_information(problem, free, resolution)
-        setup = og.SimpleSetup(si)
-        setup.setStartAndGoalStates(_state(si, problem.start), _state(si, problem.goal))
-        setup.setPlanner(_planner(si, planner_name, max_step))
-        start = time.perf_counter()
-        stop = _termination(ob, free, planning_time, max_checks)
-        setup.solve(stop)
-        path_time = time.perf_counter() - start
-        if not setup.haveExactSolutionPath():
-            return _OmplResult(None, path_time, 0.0)
-        path = og.PathGeometric(setup.getSolutionPath())
-        og.PathSimplifier(si).simplifyMax(path)
-        waypoints = np.array([_vector(state, problem.robot.n) for state in path.getStates()])
-        return _OmplResult(waypoints, path_time, time.perf_counter() - start - path_time)
-
-
-def _planner(si: Any, planner_name: str, max_step: float | None) -> Any:
-    """The named OMPL planner on `si`; RRTConnect and RRT* extend at most `max_step` rad at a time (None: OMPL's
-    default step)."""
-    import ompl.geometric as og
-
-    planner = getattr(og, OMPL_PLANNERS[planner_name])(si)
-    if max_step is not None and hasattr(planner, "setRange"):
-        planner.setRange(max_step)
-    return planner
-
-
-def _no_path(planner_name: str, planning_time: float, free: FreeSpace) -> str:
-    """What a search that found no exact path spent: its seconds (unless unlimited) and its validity checks."""
-    spent = f"{free.checks} validity checks" if np.isinf(planning_time) else \
-        f"{planning_time:g} s and {free.checks} validity checks"
-    return f"{planner_name}: no exact path within {spent}"
-
-
-# -- smooth path --------------------------------------------------------------------------------------
-
-
-def _clamped_cubic(chord: np.ndarray, waypoints: np.ndarray) -> Any:
-    """toppra's clamped cubic spline through `waypoints` (k, n) at chord lengths `chord` (k,), rad."""
-    from toppra.interpolator import SplineInterpolator
-
-    return SplineInterpolator(chord, waypoints, bc_type="clamped")
-
-
-def _smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float,
-                 fit: Callable[[np.ndarray, np.ndarray], Any] = _clamped_cubic,
-                 within_limits: bool = False) -> tuple[Any, int]:
-    """A spline `fit(chord, waypoints)` (a clamped cubic by default) through `waypoints` (k, n), parametrised by
-    chord length (rad), that keeps half the margin (and, `within_limits`, the joint position limits) at checks
-    every resolution/4 rad (the spline called with chord lengths); returns (the spline, repair rounds used).
-
-    After the last round the spline is returned as it is; `verify` then reports any contact."""
-    waypoints = waypoints[np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 0])]
-    for rounds in range(REPAIR_ROUNDS + 1):
-        chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1))])
-        path = fit(chord, waypoints)
-        checks = np.linspace(0.0, chord[-1], int(np.ceil(4 * chord[-1] / resolution)) + 1)
-        q = path(checks)
-        outside = ((q < free.robot.q_lower) | (q > free.robot.q_upper)).any(axis=1) if within_limits else False
-        bad = checks[(free.clearance(q) < free.margin / 2) | outside]
-        if not len(bad) or rounds == REPAIR_ROUNDS:
-            break
-        segments = np.unique(np.clip(np.searchsorted(chord, bad) - 1, 0, len(chord) - 2))
-        waypoints = np.insert(waypoints, segments + 1, (waypoints[segments] + waypoints[segments + 1]) / 2, axis=0)
-    return path, rounds
-
-
-# -- TOPP-RA ------------------------------------------------------------------------------------------
-
-
-def _time_optimal(problem: Problem, path: Any, grid_points: int) -> tuple[Any, np.ndarray] | None:
-    """TOPP-RA's time-optimal rest-to-rest timing of `path` under joint velocity and torque limits (with the
-    friction passes described in the module docstring): toppra's ParametrizeConstAccel trajectory and the
-    times (s) of its grid points, or None if the path cannot be timed within the limits."""
-    import toppra.algorithm
-    import toppra.constraint
-
-    robot = problem.robot
-    data = robot.model.createData()
-    grid = np.linspace(*path.path_interval, grid_points)
-    tangent = path(grid, 1)
-    velocity = toppra.constraint.JointVelocityConstraint(robot.qd_max)
-    bounds = (np.vstack([np.eye(robot.n), -np.eye(robot.n)]), np.concatenate([robot.tau_max, robot.tau_max]))
-    qd = robot.qd_max * np.sign(tangent)  # first pass: every moving joint at its velocity limit
-    for _ in range(FRICTION_PASSES):
-        friction = robot.friction(qd)
-        torque = toppra.constraint.SecondOrderConstraint(
-            lambda q, v, a: pin.rnea(robot.model, data, q, v, a).copy(), lambda _q: bounds[0], lambda _q: bounds[1],
-            robot.n, custom_term=lambda _path, s, friction=friction: friction[np.searchsorted(grid, s)],
-            discretization_scheme=toppra.constraint.DiscretizationType.Interpolation)
-        algorithm = toppra.algorithm.TOPPRA([velocity, torque], path, gridpoints=grid, solver_wrapper="seidel",
-                                            parametrizer="ParametrizeConstAccel")
-        motion = algorithm.compute_trajectory(0.0, 0.0)
-        if motion is None:
-            return None
-        speed = algorithm.problem_data.sd_vec
-        qd = tangent * speed[:, None]
-    return motion, _grid_times(grid, speed)
-
-
-def _grid_times(grid: np.ndarray, speed: np.ndarray) -> np.ndarray:
-    """Times (s) at the path points `grid` passed at path speeds `speed` under constant s̈ in between."""
-    return np.concatenate([[0.0], np.cumsum(2.0 * np.diff(grid) / (speed[:-1] + speed[1:]))])
-
-
-@dataclass(frozen=True)
-class _TimedPath:
-    """q(t) = path(s(t)) from toppra's trajectory (eval/evald/evaldd), tau = rnea + friction, and the torque
-    rate as the mean over TORQUE_RATE_WINDOW (see the module docstring). Before 0 and after t_f the robot rests."""
-
-    motion: Any
-    robot: Robot
-    data: pin.Data
-    slowdown: float = 1.0  # the motion at t is toppra's at t / slowdown
-
-    def __call__(self, t: np.ndarray) -> Samples:
-        t = np.asarray(t, dtype=float)
-        q, qd, qdd, tau = self._state(t)
-        half = TORQUE_RATE_WINDOW / 2
-        taud = (self._state(t + half)[3] - self._state(t - half)[3]) / TORQUE_RATE_WINDOW
-        return Samples(t, q, qd, qdd, tau, taud)
-
-    def _state(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
-        """q, qd, qdd, tau at times t (m,), each (m, n)."""
-        c = self.slowdown
-        t = np.clip(t / c, *self.motion.path_interval)
-        q, qd, qdd = self.motion.eval(t), self.motion.evald(t) / c, self.motion.evaldd(t) / c**2
-        return q, qd, qdd, rigid_torque(self.robot, q, qd, qdd, self.data) + self.robot.friction(qd)
-
-
-def _hold(problem: Problem) -> Trajectory:
-    """Standing still at the start for time.min seconds: what a plan without a trajectory leaves the robot doing."""
-    robot = problem.robot
-    rest = np.zeros((1, robot.n))
-    gravity = rigid_torque(robot, problem.start[None, :], rest, rest)  # (1, n)
-
-    def still(t: np.ndarray) -> Samples:
-        t = np.asarray(t, dtype=float)
-        zeros = np.zeros((len(t), robot.n))
-        return Samples(t, np.tile(problem.start, (len(t), 1)), zeros, zeros, np.tile(gravity, (len(t), 1)), zeros)
-
-    return Trajectory(still(np.array([0.0, problem.time.min])), still)
-
-
-def _import_backends() -> float:
-    """Import OMPL and toppra; the seconds it took: the one-time set-up (slow the first time, then nearly 0)."""
-    start = time.perf_counter()
-    import ompl.geometric  # noqa: F401
-    import toppra.algorithm  # noqa: F401
-
-    return time.perf_counter() - start
-
-
-# -- the planner --------------------------------------------------------------------------------------
 
 
 def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
                      resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
                      max_checks: int | None = None, max_step: float | None = MAX_STEP) -> Plan:
-    """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (see the module docstring).
-
-    `planner_name`: one of OMPL_PLANNERS. `planning_time` (s): OMPL's budget. RRTConnect stops at its first
-    path, so with the same `seed` it repeats exactly; RRT* and BIT* improve until the budget ends and PRM
-    watches for a solution in a second thread, so their paths may depend on machine speed. `resolution` (rad):
-    spacing of collision checks along straight joint-space segments. `grid_points`: TOPP-RA's path points.
-    `margin` (m): clearance kept while planning, lowered to the start's or goal's clearance if that is smaller.
-    `max_checks`: OMPL stops after checking this many configurations too (a budget that repeats on any machine;
-    planning_time may then be inf; only for the planners that plan in the calling thread, not PRM). `max_step`
-    (rad): the longest extension of RRTConnect and RRT* (OMPL's `range`; BIT* and PRM have none); None: OMPL's.
+    """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (the options of
+    ocpkit.planner.ompl_seed.SeedOptions: `planner_name` one of OMPL_PLANNERS, `planning_time` s, `seed`,
+    `resolution` rad, `grid_points`, `margin` m, `max_checks`, `max_step` rad).
 
     Status: "verified" or "violated" (dense `verify`), "no_path" (OMPL found no exact path in its budget) or
     "infeasible" (TOPP-RA cannot time the path); without a trajectory the plan holds the start (`Plan.found`
     False). When the goal is the start, the path has length zero: the plan is to hold still at the start for
     time.min seconds, verified like any other motion, without calling OMPL or TOPP-RA."""
-    check_ompl_planner(planner_name)
     began = time.perf_counter()
     method = {"planner": "ompl-toppra", "path_planner": planner_name, "grid_points": grid_points}
-    if np.array_equal(problem.start, problem.goal):
-        return finish(problem, _hold(problem), None, method, began, message="the goal is the start: hold still")
-    setup = _import_backends()
-    free = planning_space(problem, margin)
-    found = _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
-    extra = {"path_time_s": found.path_time, "simplify_time_s": found.simplify_time, "smooth_time_s": 0.0,
-             "toppra_time_s": 0.0, "validity_checks": free.checks, "waypoints": 0, "repair_rounds": 0,
-             "margin_m": free.margin}
-
-    def done(trajectory: Trajectory, stopped: str | None, message: str, found: bool = True) -> Plan:
-        return finish(problem, trajectory, stopped, method, began, setup_time=setup, message=message, extra=extra,
-                      found=found)
-
-    if found.waypoints is None:
-        return done(_hold(problem), "no_path", f"{_no_path(planner_name, planning_time, free)}; no trajectory: the "
-                    "plan holds the start", found=False)
-    smoothing = time.perf_counter()
-    path, rounds = _smooth_path(found.waypoints, free, resolution)
-    timing = time.perf_counter()
-    timed = _time_optimal(problem, path, grid_points)
-    extra.update(smooth_time_s=timing - smoothing, toppra_time_s=time.perf_counter() - timing,
-                 validity_checks=free.checks, waypoints=len(path.ss_waypoints), repair_rounds=rounds)
-    if timed is None:
-        return done(_hold(problem), "infeasible", "TOPP-RA: the path cannot be timed within the limits; no "
-                    "trajectory: the plan holds the start", found=False)
-    motion, knot_times = timed
-    interpolant = _TimedPath(motion, problem.robot, problem.robot.model.createData())
-    message = (f"{planner_name}: {len(found.waypoints)} waypoints, {rounds} repair rounds; "
-               f"TOPP-RA: {grid_points} grid points")
-    return done(Trajectory(interpolant(knot_times), interpolant), None, message)
+    seeded = ompl_seed(problem, SeedOptions(planner_name, planning_time, seed, resolution, grid_points, margin,
+                                            max_checks, max_step))
+    if seeded.trajectory is None:
+        return finish(problem, hold(problem), seeded.stopped, method, began, setup_time=seeded.setup_time,
+                      message=f"{seeded.message}; no trajectory: the plan holds the start", timing=seeded.timing,
+                      path=seeded.path, found=False)
+    return finish(problem, seeded.trajectory, None, method, began, setup_time=seeded.setup_time,
+                  message=seeded.message, timing=seeded.timing, path=seeded.path)
 
 
 def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
@@ -440,25 +54,4 @@ def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time
     if the OMPL planner found none within `planning_time` s and `max_checks` configurations checked (options as for
     `plan_ompl_toppra`)."""
     free = planning_space(problem, margin)
-    return _ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step).waypoints
-
-
-def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool = True,
-               slowdown: float = GUESS_SLOWDOWN, **baseline_options: Any) -> np.ndarray:
-    """A warm start: the baseline's trajectory (`plan_ompl_toppra(problem, **baseline_options)`), slowed to
-    `slowdown` times its time, sampled on the discretization's grid by `encode`. Slowed, because TOPP-RA's
-    time-optimal timing rides the velocity and torque limits with bang-bang accelerations, leaving no room for the
-    torque-rate limits and the jerk cost the NLP must meet (figures: docs/design-notes.md). Without a baseline
-    trajectory: the paper's straight line (the default) with `fallback`, else NoGuess."""
-    if not slowdown >= 1.0:
-        raise OptionError(f"slowdown must be at least 1, got {slowdown!r}")
-    baseline = plan_ompl_toppra(problem, **baseline_options)
-    if baseline.status in ("no_path", "infeasible"):
-        if fallback:
-            return discretization.initial_guess(problem)
-        raise NoGuess(f"OMPL + TOPP-RA gave no trajectory ({baseline.status}: {baseline.stats.solver_message})")
-    trajectory = baseline.trajectory
-    if isinstance(trajectory.interpolant, _TimedPath):
-        slowed = replace(trajectory.interpolant, slowdown=slowdown)
-        trajectory = Trajectory(slowed(slowdown * trajectory.knots.t), slowed)
-    return discretization.encode(trajectory)
+    return ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step).waypoints

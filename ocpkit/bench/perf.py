@@ -71,21 +71,21 @@ class Sample:
 
 
 def sample(result: Plan, linear_share: float = 0.0) -> Sample:
-    """The figures of one simultaneous plan from its stats (stats.extra["timing"], ocpkit.planner.simultaneous);
+    """The figures of one simultaneous plan from its stats (stats.timing, ocpkit.planner.simultaneous);
     `linear_share`: the fraction of IPOPT's own work (its call less the callbacks) in linear solves."""
-    timing = result.stats.extra.get("timing", {})
-    rounds = timing.get("rounds", [])
-    parts = {kind: sum(r.get(kind, 0.0) for r in rounds) for kind in EVALUATIONS}
-    total = sum(r.get("total", r["solve"]) for r in rounds)
-    parts["iteration callback"] = sum(r.get("callback_fun", 0.0) for r in rounds)
+    timing = result.stats.timing
+    rounds = timing.rounds
+    parts = {kind: sum(r.callbacks.get(kind, 0.0) for r in rounds) for kind in EVALUATIONS}
+    total = sum(r.callbacks.get("total", r.solve) for r in rounds)
+    parts["iteration callback"] = sum(r.callbacks.get("callback_fun", 0.0) for r in rounds)
     internal = total - sum(parts[k] for k in EVALUATIONS) - parts["iteration callback"]
     parts["linear solves"], parts["ipopt overhead"] = linear_share * internal, (1 - linear_share) * internal
-    parts["solver wrapper"] = sum(r["solve"] for r in rounds) - total
-    parts["verification"] = sum(r["verify"] for r in rounds)
-    parts["guess"] = timing.get("guess", 0.0)
+    parts["solver wrapper"] = timing.solve - total
+    parts["verification"] = timing.verify
+    parts["guess"] = timing.guess or 0.0
     parts["python"] = result.stats.solve_time - sum(parts.values())
-    return Sample(result.stats.solve_time, parts, [r["solve"] + r["verify"] for r in rounds],
-                  result.stats.setup_time, timing.get("setup", {}), result.stats.iterations, result.status)
+    return Sample(result.stats.solve_time, parts, [r.solve + r.verify for r in rounds],
+                  result.stats.setup_time, dict(timing.setup), result.stats.iterations, result.status)
 
 
 def planned(problem: Problem, knots: int, fresh: bool = False, linear_share: float = 0.0, **options) -> Sample:

@@ -128,8 +128,8 @@ def run_random(seed: int = 1, count: int = 30, knots: int = 12, obstacles: tuple
 def _line(problem: Problem, result: Plan) -> str:
     """The printed line of one problem: status, t_f, time, rounds, the ladder's rung (and every rung tried, when
     there were several), and the hint when it did not verify."""
-    tried = result.stats.extra.get("rungs", [])
-    trail = "" if len(tried) < 2 else " (tried " + ", ".join(f"{r['rung']} {r['status']} {r['time_s']:.1f} s"
+    tried = result.stats.rungs
+    trail = "" if len(tried) < 2 else " (tried " + ", ".join(f"{r.rung} {r.status} {r.time_s:.1f} s"
                                                             for r in tried) + ")"
     return (f"{problem.name:<10}{result.status:>16}  t_f {result.trajectory.tf:5.2f} s (bound "
             f"{problem.velocity_lower_bound():4.2f})  {result.stats.solve_time:5.2f} s  {result.stats.rounds} rounds"

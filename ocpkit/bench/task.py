@@ -3,9 +3,9 @@
 A task is plain data (a dict: the scenario mapping, case, scene, method, repeat, suite), so a local worker
 process or a Dask worker on another machine can run it; each process keeps its own build cache
 (ocpkit.planner.build_cache) while it plans one scenario, so its later methods and repeats of a shape it has built skip
-the set-up, and clears it when the scenario changes: builds held from earlier problems (about 400 MB each for a
-7-joint MBM problem, several per plan with the ladder's rungs and screening rebuilds) slowed later plans, up to
-1.5× late in a long run (README, MotionBenchMaker section). The outcome is plain data too:
+the set-up, and clears it when the scenario changes: builds held from earlier problems (large for a 7-joint MBM
+problem, and several per plan with the ladder's rungs and screening rebuilds) fill the memory and slow later
+plans (figures: docs/design-notes.md). The outcome is plain data too:
 the results row and the trajectory JSON text, written by the process that collects the outcomes.
 """
 
@@ -74,10 +74,10 @@ def _plan_or_failed(problem: Problem, method: Method, options: dict) -> Plan:
     try:
         return plan(problem, planner=method.planner, **options)
     except Exception as exc:  # noqa: BLE001 - any planner bug becomes this row's status
-        from ocpkit.baselines.ompl_toppra import _hold
+        from ocpkit.planner.ompl_seed import hold
 
         error = f"{method.planner} raised {type(exc).__name__}: {exc}"
-        return finish(problem, _hold(problem), "failed", {"planner": method.planner}, started, message=error,
+        return finish(problem, hold(problem), "failed", {"planner": method.planner}, started, message=error,
                       extra={"error": error}, found=False)
 
 

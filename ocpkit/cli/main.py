@@ -24,6 +24,8 @@ from ocpkit.result import Plan
 INTERRUPTED = 130
 WALL_TIME_OPTION = {"ompl-toppra": "planning_time"}
 """The planner option that --max-wall-time sets (default max_wall_time); OMPL's budget for the baseline."""
+LIST_WIDTH = 120
+"""Longest line of `ocpkit list`: a component's name and its docstring's first sentence, cut to fit."""
 
 
 def _plan_command(args: argparse.Namespace) -> int:
@@ -193,7 +195,8 @@ def _list_command(args: argparse.Namespace) -> int:
     for registry in (TRANSCRIPTIONS, DYNAMICS, CONSTRAINTS, SOLVERS, PLANNERS, GUESSES):
         print(registry.group.removeprefix("ocpkit."))
         for name in registry.names():
-            print(f"  {name:<17} {registry.description(name)}".rstrip())
+            head = f"  {name:<17} "
+            print(f"{head}{registry.description(name, LIST_WIDTH - len(head))}".rstrip())
     return 0
 
 

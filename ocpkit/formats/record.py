@@ -25,11 +25,11 @@ def trajectory_header(problem: Problem, plan: Plan) -> dict:
 def result_row(suite: str, case: str, plan: Plan, solve_time: float, setup_time: float) -> dict:
     """One results.csv row: times in s at full precision (so tables read back from the file are the same),
     max_violation (see `max_violation`), the verification summary as `checks` and the planner's own figures
-    (PlanStats.extra) as JSON in `extra`."""
+    (PlanStats.figures) as JSON in `extra`."""
     return {"suite": suite, "case": case, **{k: plan.method.get(k, "") for k in METHOD_COLUMNS},
             "status": plan.status, "tf": plan.trajectory.tf, "solve_time_s": solve_time, "setup_time_s": setup_time,
             "iterations": plan.stats.iterations, "max_violation": max_violation(plan),
-            "checks": plan.verification.summary(), "extra": json.dumps(plan.stats.extra)}
+            "checks": plan.verification.summary(), "extra": json.dumps(plan.stats.figures())}
 
 
 def row_key(row: dict, columns: tuple[str, ...] = KEY_COLUMNS) -> tuple[str, ...]:
@@ -40,7 +40,8 @@ def row_key(row: dict, columns: tuple[str, ...] = KEY_COLUMNS) -> tuple[str, ...
 @dataclass(frozen=True)
 class Recorded:
     """A results row's figures as numbers: status, t_f (s), computation and set-up time (s), iterations, the
-    verification summary, the planner's own figures and the largest violation (`max_violation`)."""
+    verification summary, the planner's own figures (`extra`: the JSON object of PlanStats.figures, as written)
+    and the largest violation (`max_violation`)."""
 
     status: str
     tf: float
@@ -57,9 +58,11 @@ class Recorded:
 
     @classmethod
     def of(cls, row: dict) -> Recorded:
-        """The figures of `row`, fresh from `result_row` or read back from results.csv."""
+        """The figures of `row`, fresh from `result_row` or read back from results.csv (of any version: `extra`
+        keeps whatever keys the file has; an empty or missing one reads as {})."""
         return cls(row["status"], float(row["tf"]), float(row["solve_time_s"]), float(row["setup_time_s"]),
-                   int(row["iterations"]), row["checks"], json.loads(row["extra"]), float(row["max_violation"]))
+                   int(row["iterations"]), row["checks"], json.loads(row.get("extra") or "{}"),
+                   float(row["max_violation"]))
 
 
 def max_violation(plan: Plan) -> float:

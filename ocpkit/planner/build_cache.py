@@ -27,7 +27,7 @@ from ocpkit.solvers.compiled import compile_seconds
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
 
-CACHE_SIZE = 8  # builds; one of a 7-joint MBM problem holds 350–450 MB
+CACHE_SIZE = 8  # builds (each holds an NLP graph and a prepared solver: large for a 7-joint arm)
 
 
 @dataclass(frozen=True)

@@ -1,24 +1,27 @@
-"""The straight-line initial guesses of the simultaneous planner (registry GUESSES, ocpkit.planner).
+"""The initial guesses of the simultaneous planner (registry GUESSES, ocpkit.planner).
 
-`paper`: the paper's rule, the straight joint-space line at constant speed over t_f = time.guess (10 s in the
-paper's cases: far slower than the optimum, so the first IPOPT iterations only shrink t_f).
+`paper`: the paper's rule, the straight joint-space line at constant speed over t_f = time.guess (in the paper's
+cases far slower than the optimum, so the first IPOPT iterations only shrink t_f).
 `line`: the same line over an estimated motion time, `motion_time_estimate`: the time a smooth
 (quintic) rest-to-rest motion along the line needs to keep within the velocity limits, lengthened until its
 inverse-dynamics torque keeps within the torque limits.
 `motion`: a given trajectory (any planner's, e.g. an earlier plan) sampled on the grid: a warm start.
+`ompl`: the OMPL seed (ocpkit.planner.ompl_seed: an OMPL path timed by TOPP-RA, not verified), slowed down.
 
 The simultaneous planner's default stays `paper`: `line` is faster on the paper cases, but it verified fewer of
-the shipped MBM problems and no more of the hard random suite (figures: docs/design-notes.md).
+the shipped MBM problems and no more of the hard random suite.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 
-from ocpkit.errors import OptionError
+from ocpkit.errors import NoGuess, OptionError
 from ocpkit.formats.trajectory import Trajectory
+from ocpkit.planner.ompl_seed import SeedOptions, ompl_seed, slowed
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
 from ocpkit.transcription import Discretization
@@ -27,6 +30,7 @@ PEAK_SPEED = 1.875
 """Peak of ds/dτ of the quintic rest-to-rest profile s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ (τ = t / t_f)."""
 TORQUE_SAMPLES = 21
 TORQUE_ROUNDS = 4  # lengthenings of t_f by the torque excess, at most
+GUESS_SLOWDOWN = 1.5  # the OMPL guess's motion takes this many times TOPP-RA's time (`ompl_guess`)
 
 
 def quintic(tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -79,3 +83,20 @@ def motion_guess(problem: Problem, discretization: Discretization, fallback: boo
     if joints != problem.robot.n:
         raise OptionError(f"guess 'motion': the trajectory moves {joints} joints, the robot has {problem.robot.n}")
     return discretization.encode(trajectory)
+
+
+def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool = True,
+               slowdown: float = GUESS_SLOWDOWN, **seed_options: Any) -> np.ndarray:
+    """A warm start: the OMPL seed's motion (`ompl_seed(problem, SeedOptions(**seed_options))`, never verified),
+    slowed to `slowdown` times its time, sampled on the discretization's grid by `encode`. Slowed, because
+    TOPP-RA's time-optimal timing rides the velocity and torque limits with bang-bang accelerations, leaving no
+    room for the torque-rate limits and the jerk cost the NLP must meet. Without a seed motion: the paper's
+    straight line (the default) with `fallback`, else NoGuess."""
+    if not slowdown >= 1.0:
+        raise OptionError(f"slowdown must be at least 1, got {slowdown!r}")
+    seeded = ompl_seed(problem, SeedOptions(**seed_options))
+    if seeded.trajectory is None:
+        if fallback:
+            return discretization.initial_guess(problem)
+        raise NoGuess(f"OMPL + TOPP-RA gave no trajectory ({seeded.stopped}: {seeded.message})")
+    return discretization.encode(slowed(seeded.trajectory, slowdown))

@@ -1,14 +1,13 @@
 """The fallback ladder of the simultaneous planner: the rungs tried in order until one plan verifies.
 
 A `Rung` is a small set of option overrides (initial guess and OMPL seed, knots, segments, an iteration cap per
-solve) applied to the options of the call. `climb` plans rung after rung within one wall-time budget and
-returns the first verified plan, else the best one (`rank`), with every rung's name, status, time and
-iterations in `stats.extra["rungs"]`. A rung that only lifts the iteration cap of an earlier one is skipped
-(listed in `stats.extra["skipped"]`) unless that one stopped at its cap: it would repeat the same solve. An
-empty ladder plans once with the call's options (the paper's single shot).
+solve), and `Rung.apply` is how it changes the options of the call (ocpkit.planner.options.SimultaneousOptions).
+`climb` plans rung after rung within one wall-time budget and returns the first verified plan, else the best one
+(`rank`), with every rung's name, status, time and iterations in `stats.rungs`. A rung that only lifts the
+iteration cap of an earlier one is skipped (listed in `stats.skipped`) unless that one stopped at its cap: it
+would repeat the same solve. An empty ladder plans once with the call's options (the paper's single shot).
 
-Why these rungs (tuned on `ocpkit bench random --seed 200 --count 40 --obstacles 1 3` and seed 300; measured
-on seed 500 in README.md): the straight line verifies most problems within a few hundred IPOPT iterations, and
+Why these rungs: the straight line verifies most problems within a few hundred IPOPT iterations, and
 one that has not converged by then usually ends infeasible or at the iteration limit after many seconds, so the
 first rung is capped (MAX_ITERATIONS_CAPPED, per solve and for the rung's refinement rounds together): that cap is
 how the ladder leaves a local infeasibility, a restoration phase, a t_f pinned at its upper bound, or a motion that
@@ -16,24 +15,24 @@ keeps tunnelling through a thin obstacle between check points round after round 
 TOPP-RA motion (collision-free by construction) is the better start in clutter, and another seed gives another
 homotopy class when the first one is poor. The first two OMPL rungs solve on three pseudospectral segments of 6
 intervals (19 points instead of 12 knots' 13): piecewise polynomials follow a path with corners, where one
-polynomial of degree 12 leaves it between knots (figures: docs/design-notes.md). Their path search is budgeted in
-configurations checked (OMPL_CHECKS, the budget the random suite certifies room to pass with), so whether it
-finds a path does not depend on the machine's speed. More knots resolve what a coarse grid leaves violated. The
+polynomial of degree 12 leaves it between knots. Their path search is budgeted in configurations checked
+(OMPL_CHECKS, the budget the random suite certifies room to pass with), so whether it finds a path does not depend
+on the machine's speed. More knots resolve what a coarse grid leaves violated. The
 continuation rung solves the problem relaxed first (a softened margin, wider limits) and the real one from there.
 The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
 shot finds in time.
 
 The default budget, MAX_WALL_TIME, leaves room for the first three rungs on a hard problem (MotionBenchMaker's
-shelves and cages: the capped first rung and two OMPL rungs, each a path search and its solves; figures:
-docs/design-notes.md). A verified plan returns at once; the budget is what a failure costs.
+shelves and cages: the capped first rung and two OMPL rungs, each a path search and its solves). A verified
+plan returns at once; the budget is what a failure costs.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
-options on a finer grid (one more pseudospectral segment; half as many intervals again for a local
+options on a finer grid (`finer_grid`: one more pseudospectral segment; half as many intervals again for a local
 transcription), warm-started from that plan's motion. The residual is the interpolation error of the grid, and
 a motion that already meets every path constraint often converges on the finer one within a few dozen iterations;
 the size of the residual does not tell when, so the rung is capped at FINER_ITERATIONS to leave the later rungs
-their time (figures: docs/design-notes.md).
+their time.
 """
 
 from __future__ import annotations
@@ -41,13 +40,17 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from ocpkit.formats.trajectory import Trajectory
-from ocpkit.result import Plan, PlanStats
+from ocpkit.result import Plan, RungRow
+
+if TYPE_CHECKING:
+    from ocpkit.planner.options import SimultaneousOptions
 
 MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
 MAX_WALL_TIME = 90.0  # s of computation for the whole ladder, the simultaneous planner's default (docstring)
-OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path (about 20 s on one core)
+OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 
 
@@ -57,10 +60,10 @@ class Rung:
     (None: the call's), pseudospectral `segments` of `knots` intervals each (None: the call's; a transcription
     without segments keeps the call's knots too), `max_iterations` per solve (None: the solver's; no
     refinement round starts once the rung's solves have used that many),
-    `relaxed`: a continuation, solving the problem relaxed (ocpkit.planner.refinement.RELAXED) first to warm-start the real
-    one, and `refines`: a motion to re-solve on a finer grid than the rung's own (`finer`), its guess instead of
-    `guess`. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the ladder's
-    time is up."""
+    `relaxed`: a continuation, solving the problem relaxed (ocpkit.planner.refinement.RELAXED) first to warm-start
+    the real one, and `refines`: a motion to re-solve on a finer grid than the rung's own (`finer`), its guess
+    instead of `guess`. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the
+    ladder's time is up."""
 
     name: str
     guess: str | None = None
@@ -70,6 +73,47 @@ class Rung:
     max_iterations: int | None = None
     relaxed: bool = False
     refines: Trajectory | None = field(default=None, compare=False, repr=False)
+
+    def apply(self, options: SimultaneousOptions, left: float) -> SimultaneousOptions:
+        """`options` with this rung's overrides. A rung's guess comes with its own options instead of the call's:
+        its seed, and no fallback to the straight line (a rung without a start of its own ends `no_path` instead
+        of repeating the line); an "ompl" rung's search stops after OMPL_CHECKS configurations or the `left`
+        seconds of the ladder. `knots` and `segments` apply to a pseudospectral transcription; one without
+        segments keeps the call's grid on a rung with segments. The call's own max_iterations wins over the
+        rung's cap, which caps each solve and, as the iteration budget, the rung's refinement rounds and
+        rebuilds. A rung that `refines` a motion starts from it on the finer grid (`finer_grid`)."""
+        changes: dict = {}
+        if self.guess is not None:
+            guess_options: dict = {"fallback": False}
+            if self.seed is not None:
+                guess_options["seed"] = self.seed
+            if self.guess == "ompl":
+                guess_options.update(max_checks=OMPL_CHECKS, planning_time=left)
+            changes.update(guess=self.guess, guess_options=guess_options)
+        if self.segments is None or options.pseudospectral():
+            if self.knots is not None:
+                changes["knots"] = self.knots
+            if self.segments is not None:
+                changes["transcription_options"] = {**options.transcription_options, "segments": self.segments}
+        if self.max_iterations is not None and "max_iterations" not in options.solver_options:
+            changes.update(solver_options={**options.solver_options, "max_iterations": self.max_iterations},
+                           iteration_budget=self.max_iterations)
+        if self.relaxed:
+            changes["relaxed"] = True
+        changed = dataclasses.replace(options, **changes)
+        if self.refines is not None:
+            changed = dataclasses.replace(finer_grid(changed), refines=self.refines)
+        return changed
+
+
+def finer_grid(options: SimultaneousOptions) -> SimultaneousOptions:
+    """`options` on a finer grid: one more segment of a pseudospectral transcription, else half as many intervals
+    again (rounded up)."""
+    if options.pseudospectral():
+        segments = options.transcription_options.get("segments", 1) + 1
+        return dataclasses.replace(options, transcription_options={**options.transcription_options,
+                                                                   "segments": segments})
+    return dataclasses.replace(options, knots=options.knots + (options.knots + 1) // 2)
 
 
 DEFAULT_LADDER: tuple[Rung, ...] = (
@@ -147,21 +191,21 @@ def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:
 
 
 def _combined(tried: list[tuple[Rung, Plan]], skipped: list[str]) -> Plan:
-    """The best plan of `tried` (rung, plan) pairs, its stats summed over all of them (with the names of the
-    `skipped` rungs) and its method and message naming its rung; its hint NO_PATH_HINT (through
-    stats.extra["hint"]) if it failed and OMPL found no path."""
+    """The best plan of `tried` (rung, plan) pairs, its times and iterations summed over all of them, the rungs
+    tried and the names of the `skipped` ones in its stats, and its method and message naming its rung; its hint
+    NO_PATH_HINT if it failed and OMPL found no path."""
     rung, best = min(tried, key=lambda pair: rank(pair[1]))
     plans = [p for _, p in tried]
-    stats = PlanStats(sum(p.stats.solve_time for p in plans), sum(p.stats.setup_time for p in plans),
-                      sum(p.stats.iterations for p in plans), best.stats.rounds,
-                      f"rung {rung.name}: {best.stats.solver_message}",
-                      {**best.stats.extra, "rungs": [_rung_row(r, p) for r, p in tried], "skipped": skipped})
-    if not best.ok and any(p.status == "no_path" for p in plans):
-        stats.extra["hint"] = NO_PATH_HINT
+    no_path = not best.ok and any(p.status == "no_path" for p in plans)
+    stats = dataclasses.replace(
+        best.stats, solve_time=sum(p.stats.solve_time for p in plans),
+        setup_time=sum(p.stats.setup_time for p in plans), iterations=sum(p.stats.iterations for p in plans),
+        solver_message=f"rung {rung.name}: {best.stats.solver_message}",
+        rungs=tuple(_rung_row(r, p) for r, p in tried), skipped=tuple(skipped),
+        hint=NO_PATH_HINT if no_path else best.stats.hint)
     return dataclasses.replace(best, stats=stats, method={**best.method, "rung": rung.name})
 
 
-def _rung_row(rung: Rung, plan: Plan) -> dict:
-    """One rung's entry in stats.extra["rungs"]: name, status, computation time (s), iterations."""
-    return {"rung": rung.name, "status": plan.status, "time_s": round(plan.stats.solve_time, 3),
-            "iterations": plan.stats.iterations}
+def _rung_row(rung: Rung, plan: Plan) -> RungRow:
+    """One rung's row in stats.rungs: name, status, computation time (s, to the ms), iterations."""
+    return RungRow(rung.name, plan.status, round(plan.stats.solve_time, 3), plan.stats.iterations)

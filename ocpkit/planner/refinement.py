@@ -24,6 +24,7 @@ import numpy as np
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.nlp import Layout, Refinement
 from ocpkit.problem import Problem
+from ocpkit.result import SolveTiming
 from ocpkit.solvers import PreparedSolver, SolverResult, SolverStatus, bound_slack
 from ocpkit.transcription import Discretization
 from ocpkit.verify import Verification, verify
@@ -53,15 +54,16 @@ class Refined:
     verification: Verification
     iterations: int
     rounds: int
-    timing: tuple[dict, ...] = ()
+    timing: tuple[SolveTiming, ...] = ()
 
 
-def round_timing(result: SolverResult, verify_time: float) -> dict:
-    """Seconds of one solve: `solve` (the solver call's wall time), `verify`, and the solver's own wall time per
-    NLP evaluation kind (CALLBACKS, from its stats, where it reports them); `iterations`."""
+def round_timing(result: SolverResult, verify_time: float) -> SolveTiming:
+    """Where one solve's time went: the solver call's wall time, the verification's `verify_time` (s), the
+    iterations, and the solver's own wall time (s) per NLP evaluation kind (CALLBACKS, from its stats, where it
+    reports them)."""
     stats = result.stats or {}
     callbacks = {kind: float(stats[f"t_wall_{kind}"]) for kind in CALLBACKS if f"t_wall_{kind}" in stats}
-    return {"solve": result.wall_time, "verify": verify_time, "iterations": result.iterations, **callbacks}
+    return SolveTiming(result.wall_time, verify_time, result.iterations, callbacks)
 
 
 def next_refinement(previous: Refinement, verification: Verification, tf: float) -> Refinement | None:

@@ -1,16 +1,15 @@
 """Active-set screening of the collision rows: the NLP carries only the terms that can matter near the motion.
 
-A 7-joint arm of 60 spheres among a dozen boxes has about 1100 collision terms per point (MotionBenchMaker's
-Panda: 690 sphere pairs of its own and 400 sphere-obstacle terms within reach), most of them far from contact on
-any motion the solver will consider; IPOPT's linear solves grow with every row. So the planner builds the NLP
-with the terms whose clearance is below SCREEN_DISTANCE somewhere along the straight line and along the initial
-guess (`Constraint.screened`), solves, and — verification always checks every term densely — keeps a verified plan
-as it is. An unverified plan whose motion comes within MISSING_DISTANCE of a term left out is solved again,
+An arm of many spheres among many obstacles has many collision terms per point (its own sphere pairs and the
+sphere-obstacle terms within reach), most of them far from contact on any motion the solver will consider;
+IPOPT's linear solves grow with every row. So the planner builds the NLP with the terms whose clearance is below
+SCREEN_DISTANCE somewhere along the straight line and along the initial guess (`Constraint.screened`), solves,
+and — verification always checks every term densely — keeps a verified plan as it is. An unverified plan whose motion comes within MISSING_DISTANCE of a term left out is solved again,
 warm-started, with the terms near it added (a rebuild, part of the computation time), at most MAX_REBUILDS times;
-such a motion also ends the refinement rounds at once (ocpkit.planner.refinement), since rounds on an NLP without those rows
-cannot fix it (before, a capped rung spent its iterations on them and ended `violated`, the rows still missing).
-Every robot and scene with collision terms screens, the paper's robot (75 terms per point) too: its paper cases keep
-few of them, and IPOPT's linear solves shrink with the rows (figures: docs/design-notes.md).
+such a motion also ends the refinement rounds at once (ocpkit.planner.refinement), since rounds on an NLP without
+those rows cannot fix it: they would spend the rung's iterations and end `violated`, the rows still missing.
+Every robot and scene with collision terms screens, the paper's robot too: its paper cases keep few of them, and
+IPOPT's linear solves shrink with the rows.
 """
 
 from __future__ import annotations

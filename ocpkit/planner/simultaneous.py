@@ -20,19 +20,13 @@ from ocpkit.formats.trajectory import Trajectory
 from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, screening
 from ocpkit.planner.build_cache import Build, build, construct
-from ocpkit.planner.ladder import (
-    DEFAULT_LADDER,
-    MAX_WALL_TIME,
-    OMPL_CHECKS,
-    Rung,
-    climb,
-)
+from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb
+from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.problem import Problem
-from ocpkit.result import Plan, finish
+from ocpkit.result import Plan, Screening, Timing, finish
 from ocpkit.solvers import SolverStatus
-from ocpkit.transcription import TRANSCRIPTIONS, Discretization
-from ocpkit.transcription.pseudospectral import Pseudospectral
+from ocpkit.transcription import Discretization
 
 END_CHECK_CLEARANCE = 0.05  # m: a start or goal this close to contact gets checks in every knot interval
 
@@ -51,144 +45,104 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     `knots` is N, the intervals per segment of a pseudospectral transcription (K N + 1 points on K `segments`) or
     the mesh intervals of a local one; `guess` names a registered initial-guess rule ("paper", the default: the
     paper's line over t_f = time.guess; "line": the straight joint-space line over an estimated motion time,
-    ocpkit.planner.guesses; "motion": a Trajectory given as guess option "trajectory"; "ompl": the OMPL + TOPP-RA
-    baseline's motion) or is a decision vector for this shape, with
-    `guess_options` for the rule (e.g. {"seed": 3, "planning_time": 2.0} for "ompl", the baseline's options);
+    ocpkit.planner.guesses; "motion": a Trajectory given as guess option "trajectory"; "ompl": an OMPL path timed
+    by TOPP-RA, ocpkit.planner.ompl_seed) or is a decision vector for this shape, with `guess_options` for the rule
+    (e.g. {"seed": 3, "planning_time": 2.0} for "ompl", the options of ocpkit.planner.ompl_seed.SeedOptions);
     `refinements` bounds the re-solve rounds. Components and options as for `ocpkit.build`. The guess is part of the
     computation time; the one-time set-up is not. `max_wall_time` (s; ocpkit.planner.ladder.MAX_WALL_TIME) bounds the
     computation (guess, every solve and refinement round, every rung): each solve gets the time left (a solver that
     cannot be interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when
-    it runs out. `fallbacks` is the ladder of rungs (ocpkit.planner.ladder), each overriding these options, tried in order
-    until one plan verifies; () plans once with these options (SINGLE_SHOT, the paper's setting). `screen`: whether
-    the NLP carries only the collision rows near the motion (ocpkit.planner.screening; None: whenever the robot and scene
-    have collision terms)."""
-    options = {"transcription": transcription, "knots": knots, "dynamics": dynamics, "solver": solver,
-               "guess": guess, "refinements": refinements, "constraints": constraints,
-               "transcription_options": transcription_options or {}, "solver_options": solver_options or {},
-               "dynamics_options": dynamics_options, "guess_options": guess_options or {}, "screen": screen}
-    return climb(lambda rung, left: _single_shot(problem, _overridden(options, rung, left), left), fallbacks,
-                 max_wall_time)
+    it runs out. `fallbacks` is the ladder of rungs (ocpkit.planner.ladder), each overriding these options
+    (Rung.apply), tried in order until one plan verifies; () plans once with these options (SINGLE_SHOT, the
+    paper's setting). `screen`: whether the NLP carries only the collision rows near the motion
+    (ocpkit.planner.screening; None: whenever the robot and scene have collision terms). The options travel as one
+    ocpkit.planner.options.SimultaneousOptions."""
+    options = SimultaneousOptions(
+        transcription=transcription, knots=knots, dynamics=dynamics, solver=solver, guess=guess,
+        refinements=refinements, constraints=constraints, transcription_options=transcription_options or {},
+        solver_options=solver_options or {}, dynamics_options=dynamics_options, max_wall_time=max_wall_time,
+        guess_options=guess_options or {}, fallbacks=fallbacks, screen=screen)
+
+    def attempt(rung: Rung | None, left: float) -> Plan:
+        return _single_shot(problem, options if rung is None else rung.apply(options, left), left)
+
+    return climb(attempt, options.fallbacks, options.max_wall_time)
 
 
-def _overridden(options: dict, rung: Rung | None, left: float) -> dict:
-    """The options of `plan_simultaneous` with `rung`'s overrides applied (`options` itself for None); a rung's
-    guess comes with its own options (its seed, and no fallback to the straight line: a rung without a start of
-    its own ends `no_path` instead of repeating the line; an "ompl" rung's search budget, OMPL_CHECKS or the `left`
-    seconds of the ladder) instead of the call's; the call's own max_iterations wins over a rung's cap, which caps
-    each solve and, as `iteration_budget`, the rung's refinement rounds and rebuilds. A rung that `refines` a
-    motion starts from it (guess "motion") on the finer grid."""
-    if rung is None:
-        return options
-    changed = dict(options)
-    if rung.guess is not None:
-        changed["guess"] = rung.guess
-        guess_options = {"fallback": False}
-        if rung.seed is not None:
-            guess_options["seed"] = rung.seed
-        if rung.guess == "ompl":
-            guess_options.update(max_checks=OMPL_CHECKS, planning_time=left)
-        changed["guess_options"] = guess_options
-    if rung.segments is not None and not issubclass(TRANSCRIPTIONS.get(options["transcription"]), Pseudospectral):
-        rung = dataclasses.replace(rung, knots=None, segments=None)
-    if rung.knots is not None:
-        changed["knots"] = rung.knots
-    if rung.segments is not None:
-        changed["transcription_options"] = {**options["transcription_options"], "segments": rung.segments}
-    if rung.max_iterations is not None and "max_iterations" not in options["solver_options"]:
-        changed["solver_options"] = {**options["solver_options"], "max_iterations": rung.max_iterations}
-        changed["iteration_budget"] = rung.max_iterations
-    if rung.relaxed:
-        changed["relaxed"] = True
-    if rung.refines is not None:
-        changed.update(_finer_grid(changed), guess="motion", guess_options={"trajectory": rung.refines})
-    return changed
-
-
-def _finer_grid(options: dict) -> dict:
-    """The grid options of `options` refined (ocpkit.planner.ladder.finer): one more segment of a pseudospectral
-    transcription, else half as many intervals again."""
-    if issubclass(TRANSCRIPTIONS.get(options["transcription"]), Pseudospectral):
-        segments = options["transcription_options"].get("segments", 1) + 1
-        return {"transcription_options": {**options["transcription_options"], "segments": segments}}
-    return {"knots": options["knots"] + (options["knots"] + 1) // 2}
-
-
-def _single_shot(problem: Problem, options: dict, max_wall_time: float) -> Plan:
-    """One plan with `options` (those of `plan_simultaneous`): build, guess, solve with refinement rounds, all
-    within `max_wall_time` (s) of computation. A guess rule with no start to offer (NoGuess) ends the plan as
-    `no_path` before any solve. With screening (ocpkit.planner.screening) the first build keeps the collision rows near
-    the straight line; a guess or an unverified solution that comes near rows left out is solved again on a
-    rebuild with them added."""
+def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: float) -> Plan:
+    """One plan with `options`: build, guess, solve with refinement rounds, all within `max_wall_time` (s) of
+    computation. A guess rule with no start to offer (NoGuess) ends the plan as `no_path` before any solve. With
+    screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight line; a guess or
+    an unverified solution that comes near rows left out is solved again on a rebuild with them added."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
     options = _checked_near_the_ends(problem, options)
     made = _build(problem, options, near)
     deadline = time.perf_counter() + max_wall_time
-    dynamics = options["dynamics"]
-    method = {"planner": "simultaneous", "transcription": options["transcription"], "knots": options["knots"],
-              "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options["solver"]}
+    dynamics = options.dynamics
+    method = {"planner": "simultaneous", "transcription": options.transcription, "knots": options.knots,
+              "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options.solver}
+    guess, guess_options = options.starting_guess()
     guessing = time.perf_counter()
     try:
-        w = _guess(problem, made.discretization, options["guess"], options["guess_options"])
+        w = _guess(problem, made.discretization, guess, guess_options)
     except NoGuess as exc:
         line = made.discretization.decode(made.discretization.initial_guess(problem))
         return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
-                      message=f"guess {options['guess']!r}: {exc}; not solved")
+                      message=f"guess {guess!r}: {exc}; not solved")
     guess_time = time.perf_counter() - guessing
     first_setup = made.setup_time
     if near is not None and (wider := _widened(problem, options, made, near, made.discretization.decode(w))):
         made, near = wider
-    budget = options.get("iteration_budget", np.inf)
-    refined = solve_refined(made.discretization, made.solver, problem, w, options["refinements"], deadline,
-                            RELAXED if options.get("relaxed") else None, budget, _lacking(problem, made, near))
+    budget = options.iteration_budget
+    refined = solve_refined(made.discretization, made.solver, problem, w, options.refinements, deadline,
+                            RELAXED if options.relaxed else None, budget, _lacking(problem, made, near))
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
             and time.perf_counter() < deadline and refined.iterations < budget \
-            and (wider := _widened(problem, _capped(options, budget - refined.iterations), made, near,
+            and (wider := _widened(problem, options.capped(budget - refined.iterations), made, near,
                                    refined.trajectory)):
         (made, near), rebuilds = wider, rebuilds + 1
         restart = made.discretization.relifted(refined.result.w, Refinement())  # the checks back at their defaults
         refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, restart,
-                                                    options["refinements"], deadline,
+                                                    options.refinements, deadline,
                                                     iteration_budget=budget - refined.iterations,
                                                     lacking=_lacking(problem, made, near)))
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
-    extra = {"timing": {"guess": guess_time, "rounds": list(refined.timing), "setup": made.setup_parts}}
-    if near is not None:
-        extra["screening"] = {"rows_per_point": screening.screenable_rows(made.discretization.constraints),
-                              "rebuilds": rebuilds}
+    timing = Timing(guess=guess_time, setup=made.setup_parts, rounds=refined.timing)
+    screened = None if near is None else \
+        Screening(screening.screenable_rows(made.discretization.constraints), rebuilds)
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=first_setup,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
-                  verification=refined.verification, extra=extra)
+                  verification=refined.verification, timing=timing, screening=screened)
 
 
-def _screening_start(problem: Problem, options: dict) -> np.ndarray | None:
+def _screening_start(problem: Problem, options: SimultaneousOptions) -> np.ndarray | None:
     """The configurations the first build screens the collision rows by (the straight line), or None when the
     plan does not screen (`screen` False, or None and no collision terms to screen: ocpkit.planner.screening)."""
-    screen = options["screen"]
+    screen = options.screen
     if screen is None:
-        screen = screening.worth_screening(make_constraints(problem, options["constraints"]))
+        screen = screening.worth_screening(make_constraints(problem, options.constraints))
     return screening.line_samples(problem) if screen else None
 
 
-def _checked_near_the_ends(problem: Problem, options: dict) -> dict:
+def _checked_near_the_ends(problem: Problem, options: SimultaneousOptions) -> SimultaneousOptions:
     """`options` with `end_checks` for a pseudospectral transcription (unless given) when the start or the goal is
     within END_CHECK_CLEARANCE of contact: the arm still moves fast in the short knot intervals near an end, and can
     dip between two knots into whatever it starts or stops beside (ocpkit.transcription.pseudospectral)."""
-    transcription = TRANSCRIPTIONS.get(options["transcription"])
-    if not issubclass(transcription, Pseudospectral) or "end_checks" in options["transcription_options"]:
+    if not options.pseudospectral() or "end_checks" in options.transcription_options:
         return options
     if problem.end_clearances.smallest() >= END_CHECK_CLEARANCE:
         return options
-    return {**options, "transcription_options": {**options["transcription_options"], "end_checks": True}}
+    return dataclasses.replace(options, transcription_options={**options.transcription_options, "end_checks": True})
 
 
-def _build(problem: Problem, options: dict, near: np.ndarray | None) -> Build:
-    """The build of `options` (those of `plan_simultaneous`), its collision rows screened by `near`."""
-    return build(problem, options["transcription"], options["knots"], options["dynamics"], options["solver"],
-                 options["constraints"], options["transcription_options"], options["solver_options"],
-                 options["dynamics_options"], near=near)
+def _build(problem: Problem, options: SimultaneousOptions, near: np.ndarray | None) -> Build:
+    """The build of `options`, its collision rows screened by `near`."""
+    return build(problem, options.transcription, options.knots, options.dynamics, options.solver,
+                 options.constraints, dict(options.transcription_options), dict(options.solver_options),
+                 options.dynamics_options, near=near)
 
 
 def _lacking(problem: Problem, made: Build, near: np.ndarray | None) -> Callable[[Trajectory], bool] | None:
@@ -205,7 +159,7 @@ def _near_left_out(problem: Problem, made: Build, motion: Trajectory) -> np.ndar
     return samples if screening.missing(problem, made.discretization.constraints, samples) else None
 
 
-def _widened(problem: Problem, options: dict, made: Build, near: np.ndarray,
+def _widened(problem: Problem, options: SimultaneousOptions, made: Build, near: np.ndarray,
              motion: Trajectory) -> tuple[Build, np.ndarray] | None:
     """The rebuild screened by `near` and samples of `motion` when `motion` comes near rows `made` left out, with
     those configurations (K, n); None when it does not."""
@@ -216,22 +170,14 @@ def _widened(problem: Problem, options: dict, made: Build, near: np.ndarray,
     return _build(problem, options, near), near
 
 
-def _capped(options: dict, iterations: float) -> dict:
-    """`options` whose solves stop after `iterations` (the rest of a capped rung's budget; inf: unchanged), so a
-    rebuild's solve cannot take the rung past its budget."""
-    if not np.isfinite(iterations):
-        return options
-    cap = min(int(iterations), options["solver_options"].get("max_iterations", np.inf))
-    return {**options, "solver_options": {**options["solver_options"], "max_iterations": cap}}
-
-
 def _continued(before: Refined, after: Refined) -> Refined:
     """`after`, a solve that continued from `before`'s solution, with both solves' iterations, rounds and timing."""
     return dataclasses.replace(after, iterations=before.iterations + after.iterations,
                                rounds=before.rounds + after.rounds, timing=before.timing + after.timing)
 
 
-def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray, options: dict) -> np.ndarray:
+def _guess(problem: Problem, discretization: Discretization, guess: str | np.ndarray,
+           options: dict) -> np.ndarray:
     """The decision vector w₀ (n_w,) of the named guess rule (with `options`), or `guess` itself; OptionError if its
     length is not n_w."""
     if isinstance(guess, str):

@@ -225,14 +225,14 @@ def test_a_path_that_leaves_the_joint_limits_is_repaired():
 
     problem = next(p for p in random_problems(1, 30) if p.name == "random7")
     plan = ocpkit.plan(problem, planner="ompl-topp3")
-    assert plan.stats.extra["repair_rounds"] >= 1
+    assert plan.stats.path.repair_rounds >= 1 and plan.stats.figures()["repair_rounds"] >= 1
     assert plan.status == "verified", plan.verification.summary()
 
 
 def test_without_a_toppra_profile_the_timing_starts_from_constant_speed(monkeypatch):
     import ocpkit.baselines.ompl_topp3 as topp3
 
-    monkeypatch.setattr(topp3, "_time_optimal", lambda *args: None)
+    monkeypatch.setattr(topp3, "time_optimal", lambda *args: None)
     plan = ocpkit.plan(ocpkit.load_scenario(REPO / "scenarios/paper/case4.yaml"), planner="ompl-topp3")
     assert "from s at constant speed" in plan.stats.solver_message
     assert plan.status == "verified", plan.verification.summary()

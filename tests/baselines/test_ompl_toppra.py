@@ -7,25 +7,22 @@ import dataclasses
 import time
 
 import numpy as np
-import pinocchio as pin
 import pytest
-from helpers import REPO, discretize
+from helpers import REPO
 
 import ocpkit
 import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
-from ocpkit.baselines.ompl_toppra import (
-    GUESS_SLOWDOWN,
+from ocpkit.baselines.ompl_toppra import plan_ompl_toppra
+from ocpkit.errors import OptionError, RegistryError, ScenarioError
+from ocpkit.geometry.clearances import clearances, sphere_centers
+from ocpkit.planner.ompl_seed import (
     MAX_STEP,
     FreeSpace,
     _planner,
     _space_information,
     _state,
-    ompl_guess,
-    plan_ompl_toppra,
     planning_space,
 )
-from ocpkit.errors import OptionError, RegistryError, ScenarioError
-from ocpkit.geometry.clearances import clearances, sphere_centers
 from ocpkit.tolerances import GEOMETRY_TOLERANCE
 
 
@@ -104,7 +101,7 @@ def test_no_path_within_the_budget_is_a_status_and_the_robot_holds_still(case1):
 def test_a_budget_in_checks_stops_the_search_without_a_timer(case1):
     plan = plan_ompl_toppra(case1, planning_time=np.inf, max_checks=0)
     assert plan.status == "no_path" and "validity checks" in plan.stats.solver_message
-    assert plan.stats.extra["validity_checks"] < 1000  # checked between OMPL's steps: at most one segment late
+    assert plan.stats.path.validity_checks < 1000  # checked between OMPL's steps: at most one segment late
     with pytest.raises(OptionError, match="prm"):
         plan_ompl_toppra(case1, planner_name="prm", max_checks=50)
 
@@ -146,43 +143,13 @@ def test_case1_is_planned_from_rest_to_rest_and_only_the_torque_rate_fails(case1
     assert plan.status == ("verified" if not failed else "violated")
     assert case1.velocity_lower_bound() < plan.trajectory.tf < 2.0
     assert plan.method == {"planner": "ompl-toppra", "path_planner": "rrtconnect", "grid_points": 1000}
-    extra = plan.stats.extra
-    assert extra["validity_checks"] > 0 and extra["waypoints"] >= 2
-    assert all(extra[key] > 0 for key in ("path_time_s", "simplify_time_s", "toppra_time_s"))
-
-
-@pytest.mark.slow
-def test_ompl_guess_is_the_baseline_motion_slowed_on_the_nlp_grid(case1):
-    nlp = discretize(case1, "chebyshev", "casadi-rnea", knots=6)
-    baseline = plan_ompl_toppra(case1)
-    w = ompl_guess(case1, nlp)
-    assert w.shape == nlp.initial_guess(case1).shape
-    decoded = nlp.decode(w)
-    assert decoded.tf == pytest.approx(GUESS_SLOWDOWN * baseline.trajectory.tf)
-    np.testing.assert_allclose(decoded.knots.q[[0, -1]], [case1.start, case1.goal], atol=1e-9)
-    middle = baseline.trajectory.tf / 2
-    np.testing.assert_allclose(decoded.interpolant(np.array([GUESS_SLOWDOWN * middle])).q,
-                               baseline.trajectory.interpolant(np.array([middle])).q, atol=0.05)
-    assert nlp.decode(ompl_guess(case1, nlp, slowdown=1.0)).tf == pytest.approx(baseline.trajectory.tf)
-    np.testing.assert_array_equal(ompl_guess(case1, nlp, planning_time=0.0), nlp.initial_guess(case1))
-    with pytest.raises(OptionError, match="slowdown"):
-        ompl_guess(case1, nlp, slowdown=0.5)
-
-
-@pytest.mark.slow
-def test_a_slowed_motion_is_the_same_path_at_a_slower_pace_with_its_own_torque(case1):
-    """q(t) = q₀(t / c), q̇ = q̇₀ / c, q̈ = q̈₀ / c², and the torque is pinocchio's RNEA of those plus friction."""
-    timed = plan_ompl_toppra(case1).trajectory.interpolant
-    slowed = dataclasses.replace(timed, slowdown=2.0)
-    t = np.linspace(0.05, 0.9, 7) * 2.0 * timed.motion.path_interval[1]
-    fast, slow = timed(t / 2.0), slowed(t)
-    np.testing.assert_allclose(slow.q, fast.q, atol=1e-12)
-    np.testing.assert_allclose(slow.qd, fast.qd / 2.0, atol=1e-12)
-    np.testing.assert_allclose(slow.qdd, fast.qdd / 4.0, atol=1e-12)
-    robot = case1.robot
-    data = robot.model.createData()
-    expected = [pin.rnea(robot.model, data, *row).copy() for row in zip(slow.q, slow.qd, slow.qdd)]
-    np.testing.assert_allclose(slow.tau, np.array(expected) + robot.friction(slow.qd), atol=1e-9)
+    path, timing = plan.stats.path, plan.stats.timing
+    assert path.validity_checks > 0 and path.waypoints >= 2
+    assert all(seconds > 0 for seconds in (timing.path_search, timing.simplify, timing.path_timing))
+    figures = plan.stats.figures()
+    assert set(figures) == {"path_time_s", "simplify_time_s", "smooth_time_s", "toppra_time_s", "validity_checks",
+                            "waypoints", "repair_rounds", "margin_m"}
+    assert (figures["validity_checks"], figures["toppra_time_s"]) == (path.validity_checks, timing.path_timing)
 
 
 def test_a_goal_equal_to_the_start_is_a_verified_hold_at_the_start(case1):

@@ -11,7 +11,6 @@ import pytest
 from helpers import REPO
 
 import ocpkit
-from ocpkit.baselines.ompl_toppra import ompl_guess
 from ocpkit.bench import paper
 from ocpkit.bench import random as random_suite
 from ocpkit.bench.common import Results
@@ -19,6 +18,7 @@ from ocpkit.cli.main import _planner_options, parser
 from ocpkit.errors import NoGuess, OptionError
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.planner import GUESSES
+from ocpkit.planner.guesses import ompl_guess
 from ocpkit.planner.ladder import (
     DEFAULT_LADDER,
     FINER_ITERATIONS,
@@ -28,10 +28,12 @@ from ocpkit.planner.ladder import (
     Rung,
     climb,
     finer,
+    finer_grid,
     rank,
 )
-from ocpkit.planner.simultaneous import _capped, _overridden, plan_simultaneous
-from ocpkit.result import Plan, PlanStats
+from ocpkit.planner.options import SimultaneousOptions
+from ocpkit.planner.simultaneous import plan_simultaneous
+from ocpkit.result import Plan, PlanStats, RungRow
 from ocpkit.verify import Check, Verification
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -43,7 +45,7 @@ def fake(status: str, worst: float = 0.0, seconds: float = 1.0, iterations: int 
     round can fix unless the check is "dynamics"), `seconds` of computation."""
     times = np.array([0.5]) if worst > 0 and check != "dynamics" else np.zeros(0)
     verification = Verification((Check(check, worst, 0.0, 0.5, "m"),), times)
-    stats = PlanStats(seconds, 0.5, iterations, 1, f"{status} message", {"own": 1})
+    stats = PlanStats(seconds, 0.5, iterations, 1, f"{status} message", extra={"own": 1})
     return Plan(trajectory, status, verification, stats, {"planner": "fake"})
 
 
@@ -66,8 +68,10 @@ def test_the_first_verified_rung_wins_and_later_rungs_do_not_run():
     result = climb(script, LADDER, 60.0)
     assert [name for name, _ in script.calls] == ["a", "b"]
     assert result.ok and result.method["rung"] == "b"
-    assert result.stats.extra["rungs"] == [{"rung": "a", "status": "infeasible", "time_s": 2.0, "iterations": 10},
-                                           {"rung": "b", "status": "verified", "time_s": 1.0, "iterations": 10}]
+    assert result.stats.rungs == (RungRow("a", "infeasible", 2.0, 10), RungRow("b", "verified", 1.0, 10))
+    assert result.stats.figures()["rungs"] == [
+        {"rung": "a", "status": "infeasible", "time_s": 2.0, "iterations": 10},
+        {"rung": "b", "status": "verified", "time_s": 1.0, "iterations": 10}]
     assert (result.stats.solve_time, result.stats.setup_time, result.stats.iterations) == (3.0, 1.0, 20)
 
 
@@ -76,8 +80,9 @@ def test_without_a_verified_rung_the_smallest_violation_is_the_best():
     result = climb(script, LADDER, 60.0)
     assert result.status == "violated" and result.method["rung"] == "c"
     assert result.stats.solver_message == "rung c: violated message"
-    extra = result.stats.extra
-    assert extra["own"] == 1 and len(extra["rungs"]) == 3 and extra["skipped"] == []
+    stats = result.stats
+    assert stats.extra["own"] == 1 and len(stats.rungs) == 3 and stats.skipped == ()
+    assert stats.figures()["own"] == 1 and stats.figures()["skipped"] == []
 
 
 @pytest.mark.parametrize("statuses, best", [(("time_limit", "infeasible", "iteration_limit"), "infeasible"),
@@ -108,40 +113,63 @@ def test_an_empty_ladder_is_one_attempt_with_the_calls_options():
 
 
 def test_a_rung_overrides_only_what_it_names():
-    options = {"guess": "line", "guess_options": {"planning_time": 2.0}, "knots": 12, "transcription": "chebyshev",
-               "transcription_options": {"staged": False}, "solver_options": {"tol": 1e-7}}
-    changed = _overridden(options, Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300), 9.0)
-    assert changed == {"guess": "ompl", "guess_options": {"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
-                                                          "planning_time": 9.0}, "knots": 16,
-                       "transcription": "chebyshev", "transcription_options": {"staged": False, "segments": 2},
-                       "solver_options": {"tol": 1e-7, "max_iterations": 300}, "iteration_budget": 300}
-    assert options["knots"] == 12 and options["solver_options"] == {"tol": 1e-7}
-    assert _overridden(options, Rung("same"), 9.0) == options and _overridden(options, None, 9.0) is options
-    line = _overridden(options, Rung("line", guess="line"), 9.0)
-    assert line["guess_options"] == {"fallback": False}
-    capped = _overridden({**options, "solver_options": {"max_iterations": 50}}, Rung("cap", max_iterations=300), 9.0)
-    assert capped["solver_options"] == {"max_iterations": 50} and "iteration_budget" not in capped
+    options = SimultaneousOptions(guess="line", guess_options={"planning_time": 2.0}, knots=12,
+                                  transcription="chebyshev", transcription_options={"staged": False},
+                                  solver_options={"tol": 1e-7})
+    changed = Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300).apply(options, 9.0)
+    assert changed == dataclasses.replace(
+        options, guess="ompl", guess_options={"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
+                                              "planning_time": 9.0}, knots=16,
+        transcription_options={"staged": False, "segments": 2}, solver_options={"tol": 1e-7, "max_iterations": 300},
+        iteration_budget=300)
+    assert options.knots == 12 and options.solver_options == {"tol": 1e-7}
+    assert Rung("same").apply(options, 9.0) == options
+    line = Rung("line", guess="line").apply(options, 9.0)
+    assert line.guess_options == {"fallback": False}
+    capped = Rung("cap", max_iterations=300).apply(
+        dataclasses.replace(options, solver_options={"max_iterations": 50}), 9.0)
+    assert capped.solver_options == {"max_iterations": 50} and capped.iteration_budget == math.inf
+
+
+@pytest.mark.parametrize("rung, changes", [
+    (DEFAULT_LADDER[0], {"solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+    (DEFAULT_LADDER[1], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
+                         "guess_options": {"fallback": False, "seed": 0, "max_checks": OMPL_CHECKS,
+                                           "planning_time": 7.0},
+                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+    (DEFAULT_LADDER[2], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
+                         "guess_options": {"fallback": False, "seed": 1, "max_checks": OMPL_CHECKS,
+                                           "planning_time": 7.0},
+                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+    (DEFAULT_LADDER[3], {"guess": "ompl", "knots": 16,
+                         "guess_options": {"fallback": False, "seed": 2, "max_checks": OMPL_CHECKS,
+                                           "planning_time": 7.0},
+                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+    (DEFAULT_LADDER[4], {"relaxed": True, "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+    (DEFAULT_LADDER[5], {})])
+def test_each_default_rung_changes_the_calls_options_as_it_says(rung, changes):
+    call = SimultaneousOptions(guess_options={"seed": 9})
+    assert rung.apply(call, 7.0) == dataclasses.replace(call, **changes)
 
 
 def test_a_rebuild_solves_within_what_is_left_of_the_rungs_iteration_budget():
-    options = {"guess": "line", "solver_options": {"tol": 1e-7, "max_iterations": 300}}
-    assert _capped(options, 120.0)["solver_options"] == {"tol": 1e-7, "max_iterations": 120}
-    assert _capped(options, 500.0)["solver_options"]["max_iterations"] == 300
-    assert _capped({**options, "solver_options": {}}, 40.0)["solver_options"] == {"max_iterations": 40}
-    assert _capped(options, math.inf) is options and options["solver_options"]["max_iterations"] == 300
+    options = SimultaneousOptions(guess="line", solver_options={"tol": 1e-7, "max_iterations": 300})
+    assert options.capped(120.0).solver_options == {"tol": 1e-7, "max_iterations": 120}
+    assert options.capped(500.0).solver_options["max_iterations"] == 300
+    assert dataclasses.replace(options, solver_options={}).capped(40.0).solver_options == {"max_iterations": 40}
+    assert options.capped(math.inf) is options and options.solver_options["max_iterations"] == 300
 
 
 def test_a_transcription_without_segments_keeps_the_calls_grid_on_a_rung_with_segments():
-    options = {"guess": "line", "guess_options": {}, "knots": 40, "transcription": "trapezoidal",
-               "transcription_options": {}}
-    changed = _overridden(options, Rung("x", guess="ompl", knots=6, segments=3), 9.0)
-    assert changed["knots"] == 40 and changed["transcription_options"] == {} and changed["guess"] == "ompl"
-    assert _overridden(options, Rung("y", knots=16), 9.0)["knots"] == 16
+    options = SimultaneousOptions(guess="line", knots=40, transcription="trapezoidal")
+    changed = Rung("x", guess="ompl", knots=6, segments=3).apply(options, 9.0)
+    assert changed.knots == 40 and changed.transcription_options == {} and changed.guess == "ompl"
+    assert Rung("y", knots=16).apply(options, 9.0).knots == 16
 
 
 def test_without_a_wall_time_limit_the_ladder_ends_by_its_budgets_in_work_and_repeats():
-    ompl = _overridden({"guess": "line", "guess_options": {}}, Rung("o", guess="ompl", seed=0), math.inf)
-    assert ompl["guess_options"]["planning_time"] == math.inf and ompl["guess_options"]["max_checks"] == OMPL_CHECKS
+    ompl = Rung("o", guess="ompl", seed=0).apply(SimultaneousOptions(guess="line"), math.inf).guess_options
+    assert ompl["planning_time"] == math.inf and ompl["max_checks"] == OMPL_CHECKS
     plans = [plan_simultaneous(CASE2, knots=6, max_wall_time=math.inf) for _ in range(2)]
     assert all(p.ok for p in plans) and plans[0].stats.iterations == plans[1].stats.iterations
     np.testing.assert_array_equal(plans[0].trajectory.knots.q, plans[1].trajectory.knots.q)
@@ -155,12 +183,13 @@ def test_the_default_ladder_starts_with_the_calls_guess_and_ends_uncapped():
 def test_a_plan_that_verifies_on_the_first_rung_reports_one_rung():
     result = plan_simultaneous(CASE2, knots=6)
     assert result.ok and result.method["rung"] == DEFAULT_LADDER[0].name
-    assert [r["rung"] for r in result.stats.extra["rungs"]] == [DEFAULT_LADDER[0].name]
+    assert [r.rung for r in result.stats.rungs] == [DEFAULT_LADDER[0].name]
 
 
 def test_the_single_shot_reports_no_rungs():
     result = plan_simultaneous(CASE2, knots=6, fallbacks=SINGLE_SHOT)
-    assert result.ok and "rungs" not in result.stats.extra and "rung" not in result.method
+    assert result.ok and result.stats.rungs == () and "rung" not in result.method
+    assert "rungs" not in result.stats.figures()
 
 
 def test_single_shot_on_the_command_line_means_no_fallbacks():
@@ -173,7 +202,8 @@ def test_a_failed_ladder_where_ompl_found_no_path_says_so():
     script = Script({"a": fake("infeasible"), "b": fake("no_path"), "c": fake("iteration_limit")})
     result = climb(script, LADDER, 60.0)
     assert result.status == "infeasible" and result.hint == NO_PATH_HINT
-    assert [r["status"] for r in result.stats.extra["rungs"]] == ["infeasible", "no_path", "iteration_limit"]
+    assert [r.status for r in result.stats.rungs] == ["infeasible", "no_path", "iteration_limit"]
+    assert result.stats.hint == NO_PATH_HINT and result.stats.figures()["hint"] == NO_PATH_HINT
     script = Script({"a": fake("no_path"), "b": fake("verified")})
     assert climb(script, LADDER, 60.0).hint == ""
 
@@ -221,7 +251,7 @@ def test_an_uncapped_repeat_runs_only_after_the_cap_was_hit(first, runs):
     script = Script({"capped": fake(first), "other": fake("no_path"), "uncapped": fake("violated", 0.1)})
     result = climb(script, CAPPED, 60.0)
     assert [name for name, _ in script.calls] == runs
-    assert result.stats.extra["skipped"] == ([] if "uncapped" in runs else ["uncapped"])
+    assert result.stats.skipped == (() if "uncapped" in runs else ("uncapped",))
 
 
 def test_a_rung_whose_guess_has_no_start_ends_no_path_before_any_solve(monkeypatch):
@@ -280,11 +310,22 @@ def test_a_finer_rung_is_capped_and_not_refined_again_nor_relaxed():
 def test_a_finer_rung_adds_a_segment_or_half_the_intervals_and_starts_from_the_motion(transcription, options,
                                                                                       rung, grid):
     motion = object()
-    call = {"guess": "paper", "guess_options": {}, "knots": 12, "transcription": transcription,
-            "transcription_options": options, "solver_options": {}}
-    changed = _overridden(call, dataclasses.replace(rung, refines=motion), 9.0)
-    assert (changed["knots"], changed["transcription_options"]) == grid
-    assert changed["guess"] == "motion" and changed["guess_options"] == {"trajectory": motion}
+    call = SimultaneousOptions(transcription=transcription, knots=12, transcription_options=options,
+                               guess_options={"seed": 4})
+    changed = dataclasses.replace(rung, refines=motion).apply(call, 9.0)
+    assert (changed.knots, changed.transcription_options) == grid
+    assert changed.starting_guess() == ("motion", {"trajectory": motion})
+    assert call.starting_guess() == ("paper", {"seed": 4})
+
+
+@pytest.mark.parametrize("transcription, knots, options, grid", [
+    ("chebyshev", 12, {}, (12, {"segments": 2})), ("chebyshev", 6, {"segments": 3}, (6, {"segments": 4})),
+    ("lgl", 8, {}, (8, {"segments": 2})), ("trapezoidal", 40, {}, (60, {})), ("trapezoidal", 5, {}, (8, {})),
+    ("hermite-simpson", 15, {}, (23, {}))])
+def test_the_finer_grid_is_one_more_segment_else_half_as_many_intervals_again(transcription, knots, options, grid):
+    finer = finer_grid(SimultaneousOptions(transcription=transcription, knots=knots,
+                                           transcription_options=options))
+    assert (finer.knots, finer.transcription_options) == grid
 
 
 def test_the_motion_guess_samples_a_trajectory_on_another_grid():

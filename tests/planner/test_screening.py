@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -9,6 +11,7 @@ from ocpkit.constraints import make_constraints
 from ocpkit.constraints.collision import SphereCollision
 from ocpkit.formats.scenario import load_scenario
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
+from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.screening import line_samples, worth_screening
 from ocpkit.planner.simultaneous import (
     END_CHECK_CLEARANCE,
@@ -20,7 +23,7 @@ from tests.helpers import REPO
 
 PANDA = load_scenario(REPO / "scenarios/mbm/panda/table_pick/0001.yaml")
 PAPER = load_scenario(REPO / "scenarios/paper/case2.yaml")
-PLAN_OPTIONS = {"transcription": "chebyshev", "transcription_options": {}}
+PLAN_OPTIONS = SimultaneousOptions(transcription="chebyshev")
 
 
 def test_screening_keeps_exactly_the_terms_close_to_some_configuration():
@@ -62,7 +65,7 @@ def test_other_constraints_are_not_screened():
 def test_a_screened_plan_is_verified_on_every_term():
     plan = plan_simultaneous(PAPER, fallbacks=(), screen=True)
     assert plan.status == "verified"  # verification checks every term, screened or not
-    assert plan.stats.extra["screening"]["rows_per_point"] < SphereCollision(PAPER).term_count
+    assert plan.stats.screening.rows_per_point < SphereCollision(PAPER).term_count
 
 
 def test_every_knot_interval_is_checked_when_asked():
@@ -75,10 +78,10 @@ def test_every_knot_interval_is_checked_when_asked():
 
 def test_a_plan_checks_near_the_ends_when_an_end_is_close_to_contact_unless_told_otherwise():
     assert PANDA.end_clearances.smallest() < END_CHECK_CLEARANCE  # MBM's goal on the table
-    assert _checked_near_the_ends(PANDA, PLAN_OPTIONS)["transcription_options"] == {"end_checks": True}
+    assert _checked_near_the_ends(PANDA, PLAN_OPTIONS).transcription_options == {"end_checks": True}
     assert PAPER.end_clearances.smallest() >= END_CHECK_CLEARANCE
     assert _checked_near_the_ends(PAPER, PLAN_OPTIONS) is PLAN_OPTIONS  # the paper's ends are clear of everything
-    told = {**PLAN_OPTIONS, "transcription_options": {"end_checks": False}}
+    told = dataclasses.replace(PLAN_OPTIONS, transcription_options={"end_checks": False})
     assert _checked_near_the_ends(PANDA, told) is told
-    mesh = {**PLAN_OPTIONS, "transcription": "trapezoidal"}
+    mesh = dataclasses.replace(PLAN_OPTIONS, transcription="trapezoidal")
     assert _checked_near_the_ends(PANDA, mesh) is mesh  # a mesh transcription has no such option

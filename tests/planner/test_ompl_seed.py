@@ -1,0 +1,102 @@
+"""The OMPL seed: a timed motion without verification, the same one the ompl-toppra baseline verifies, and the
+simultaneous planner's "ompl" guess (slowed, on the NLP grid) made from it without any verification."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from helpers import REPO, discretize
+
+import ocpkit
+from ocpkit.baselines.ompl_toppra import plan_ompl_toppra
+from ocpkit.errors import OptionError
+from ocpkit.planner.guesses import GUESS_SLOWDOWN, ompl_guess
+from ocpkit.planner.ompl_seed import PathMotion, SeedOptions, ompl_seed, slowed
+
+
+@pytest.fixture(scope="module")
+def case1():
+    return ocpkit.load_scenario(REPO / "scenarios/paper/case1.yaml")
+
+
+@pytest.fixture
+def no_verify(monkeypatch):
+    """`verify` replaced, where the planners call it, by a stand-in that raises."""
+    def refuse(*args, **kwargs):
+        raise AssertionError("verify was called")
+
+    for module in ("ocpkit.verify", "ocpkit.result", "ocpkit.planner.refinement"):
+        monkeypatch.setattr(importlib.import_module(module), "verify", refuse)
+
+
+def test_the_seed_is_the_baselines_motion_and_its_figures(case1):
+    seed, plan = ompl_seed(case1, SeedOptions(seed=2)), plan_ompl_toppra(case1, seed=2)
+    assert seed.stopped is None and isinstance(seed.trajectory.interpolant, PathMotion)
+    np.testing.assert_array_equal(seed.trajectory.knots.q, plan.trajectory.knots.q)
+    assert seed.path == plan.stats.path and seed.message == plan.stats.solver_message
+    assert seed.timing.path_search > 0 and seed.timing.path_timing > 0 and seed.timing.guess is None
+
+
+def test_the_ompl_guess_never_verifies(case1, no_verify):
+    nlp = discretize(case1, "chebyshev", "casadi-rnea", knots=6)
+    decoded = nlp.decode(ompl_guess(case1, nlp))
+    np.testing.assert_allclose(decoded.knots.q[[0, -1]], [case1.start, case1.goal], atol=1e-9)
+    assert decoded.tf > case1.velocity_lower_bound()
+    with pytest.raises(AssertionError, match="verify was called"):
+        plan_ompl_toppra(case1)  # the baseline does verify: the stand-in is in place
+
+
+def test_without_a_path_the_seed_has_no_motion_and_says_why(case1, no_verify):
+    seed = ompl_seed(case1, SeedOptions(planning_time=0.0))
+    assert seed.trajectory is None and seed.stopped == "no_path" and "no exact path" in seed.message
+    assert seed.path.waypoints == 0 and seed.timing.smooth == 0.0
+
+
+def test_an_option_the_seed_does_not_take_is_refused_by_the_planner(case1):
+    with pytest.raises(OptionError, match="guess 'ompl'.*knots"):
+        ocpkit.plan(case1, knots=6, guess="ompl", guess_options={"knots": 3}, fallbacks=())
+
+
+@pytest.mark.slow
+def test_ompl_guess_is_the_baseline_motion_slowed_on_the_nlp_grid(case1):
+    nlp = discretize(case1, "chebyshev", "casadi-rnea", knots=6)
+    baseline = plan_ompl_toppra(case1)
+    w = ompl_guess(case1, nlp)
+    assert w.shape == nlp.initial_guess(case1).shape
+    decoded = nlp.decode(w)
+    assert decoded.tf == pytest.approx(GUESS_SLOWDOWN * baseline.trajectory.tf)
+    np.testing.assert_allclose(decoded.knots.q[[0, -1]], [case1.start, case1.goal], atol=1e-9)
+    middle = baseline.trajectory.tf / 2
+    np.testing.assert_allclose(decoded.interpolant(np.array([GUESS_SLOWDOWN * middle])).q,
+                               baseline.trajectory.interpolant(np.array([middle])).q, atol=0.05)
+    assert nlp.decode(ompl_guess(case1, nlp, slowdown=1.0)).tf == pytest.approx(baseline.trajectory.tf)
+    np.testing.assert_array_equal(ompl_guess(case1, nlp, planning_time=0.0), nlp.initial_guess(case1))
+    with pytest.raises(OptionError, match="slowdown"):
+        ompl_guess(case1, nlp, slowdown=0.5)
+
+
+@pytest.mark.slow
+def test_a_slowed_motion_is_the_same_path_at_a_slower_pace_with_its_own_torque(case1):
+    """q(t) = q₀(t / c), q̇ = q̇₀ / c, q̈ = q̈₀ / c², and the torque is pinocchio's RNEA of those plus friction."""
+    motion = ompl_seed(case1).trajectory
+    timed = motion.interpolant
+    slower = dataclasses.replace(timed, slowdown=2.0)
+    t = np.linspace(0.05, 0.9, 7) * 2.0 * timed.motion.path_interval[1]
+    fast, slow = timed(t / 2.0), slower(t)
+    np.testing.assert_allclose(slow.q, fast.q, atol=1e-12)
+    np.testing.assert_allclose(slow.qd, fast.qd / 2.0, atol=1e-12)
+    np.testing.assert_allclose(slow.qdd, fast.qdd / 4.0, atol=1e-12)
+    robot = case1.robot
+    data = robot.model.createData()
+    expected = [pin.rnea(robot.model, data, *row).copy() for row in zip(slow.q, slow.qd, slow.qdd)]
+    np.testing.assert_allclose(slow.tau, np.array(expected) + robot.friction(slow.qd), atol=1e-9)
+    assert slowed(motion, 2.0).tf == pytest.approx(2.0 * motion.tf)
+
+
+def test_a_hold_is_not_slowed(case1):
+    still = ompl_seed(dataclasses.replace(case1, goal=case1.start.copy()))
+    assert still.stopped is None and still.path is None and slowed(still.trajectory, 2.0) is still.trajectory
