@@ -9,6 +9,7 @@ positions are numbers, so queries that differ only in them share a build. The ca
 
 from __future__ import annotations
 
+import inspect
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
@@ -23,6 +24,7 @@ from ocpkit.errors import OptionError
 from ocpkit.planner.screening import SCREEN_DISTANCE
 from ocpkit.problem import Problem
 from ocpkit.solvers import SOLVERS, PreparedSolver
+from ocpkit.solvers.base import STAGES_NEEDED
 from ocpkit.solvers.compiled import compile_seconds
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
@@ -54,11 +56,11 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     dynamics backend also as an instance; unknown options raise OptionError. `ocp` is the OCP to discretize:
     the robot OCP of `problem` by default (ocpkit.transcription.ocp). With `near` (K, n), the constraints keep only
     the rows that can be active near those configurations (ocpkit.planner.screening)."""
-    method = construct(TRANSCRIPTIONS.get(transcription), transcription, {"knots": knots,
-                                                                          **(transcription_options or {})})
+    options = solver_options or {}
+    transcription_options = _staged_for(solver, options, transcription, transcription_options or {})
+    method = construct(TRANSCRIPTIONS.get(transcription), transcription, {"knots": knots, **transcription_options})
     backend = make_dynamics(dynamics, problem.robot, **(dynamics_options or {}))
     plugins = make_constraints(problem, constraints, None if near is None else (near, SCREEN_DISTANCE))
-    options = solver_options or {}
     nlp_solver = construct(SOLVERS.get(solver), solver, options)  # a wrong name or option fails before a build
     key = (method.shape_key(backend, plugins, ocp), solver, frozen(options))
     if key in _BUILDS:
@@ -74,6 +76,19 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     while len(_BUILDS) > CACHE_SIZE:
         _BUILDS.popitem(last=False)
     return _BUILDS[key]
+
+
+def _staged_for(solver: str, solver_options: dict, transcription: str, transcription_options: dict) -> dict:
+    """`transcription_options` with `staged=True` when `solver` needs the NLP's stage structure (fatrop) and the
+    transcription can give it; an OptionError saying what to ask for when it cannot (a pseudospectral one, or
+    staged=False given), unless the solver was told to run without (`single_stage`)."""
+    if not getattr(SOLVERS.get(solver), "needs_stages", False) or solver_options.get("single_stage"):
+        return transcription_options
+    if "staged" in inspect.signature(TRANSCRIPTIONS.get(transcription)).parameters \
+            and transcription_options.get("staged", True):
+        return {**transcription_options, "staged": True}
+    unstaged = f"{transcription} with staged=False" if "staged" in transcription_options else transcription
+    raise OptionError(STAGES_NEEDED.format(solver=solver, what=unstaged))
 
 
 def clear_builds() -> None:

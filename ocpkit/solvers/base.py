@@ -16,6 +16,7 @@ import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import ClassVar
 
 import numpy as np
 
@@ -89,6 +90,10 @@ class Solver(ABC):
     Constructors take `max_iterations` and `max_wall_time` (s) limits plus solver-specific options."""
 
     name: str
+    needs_stages: ClassVar[bool] = False
+    """Whether it needs the NLP's stage structure (ocpkit.nlp.Stages) to run at its speed: `ocpkit.build` then
+    asks a transcription that can give it for it, and refuses one that cannot (STAGES_NEEDED) unless the solver
+    is told `single_stage=True`."""
 
     @abstractmethod
     def prepare(self, nlp: NLP) -> PreparedSolver:
@@ -101,3 +106,8 @@ class Solver(ABC):
 
 
 SOLVERS: Registry[type] = Registry("solver", "ocpkit.solvers")
+
+STAGES_NEEDED = ("{solver} needs the NLP's stage structure, and {what} has none: use a local transcription "
+                 "(trapezoidal or hermite-simpson), which is staged for it, or solver_options={{'single_stage': "
+                 "True}} to run it as one dense stage (slow)")
+"""The error of a solver that needs stages (`Solver.needs_stages`) on an NLP without them."""

@@ -32,6 +32,7 @@ from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP, Stages
 from ocpkit.solvers.base import (
     BOUND_TOLERANCE,
+    STAGES_NEEDED,
     PreparedSolver,
     Solver,
     SolverResult,
@@ -327,24 +328,29 @@ class Fatrop(CasadiNlpsol):
 
     fatrop wants a stage-wise OCP: w = [x_0, u_0, ..., x_N], gap-closing rows x_{k+1} − F(x_k, u_k) = 0, every
     other row and objective term reading one stage (ocpkit.nlp.Stages). A staged NLP (the mesh transcriptions
-    with `staged=True`) is handed over with that structure (manual mode), and fatrop's Riccati recursion runs
-    stage by stage. An NLP without it (pseudospectral: the differentiation matrix couples every knot with every
-    other) gets one stage (N = 0) whose "controls" are all of w and whose stage rows are all of g: one dense
-    factorization per iteration. It needs the exact Hessian: an NLP without one (a callback dynamics backend)
+    with `staged=True`, which `ocpkit.build` asks for by itself) is handed over with that structure (manual
+    mode), and fatrop's Riccati recursion runs stage by stage. An NLP without it (pseudospectral: the
+    differentiation matrix couples every knot with every other) runs only when asked with `single_stage=True`:
+    one stage (N = 0) whose "controls" are all of w and whose stage rows are all of g, one dense factorization per
+    iteration, far slower than IPOPT on the same NLP. It needs the exact Hessian: an NLP without one (a callback dynamics backend)
     is refused with an OptionError. Extra keyword options go to fatrop verbatim."""
 
     name = plugin = "fatrop"
     statuses = {"0": SolverStatus.CONVERGED}
+    needs_stages = True
 
     def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, tol: float = 1e-6,
-                 **fatrop_options) -> None:
+                 single_stage: bool = False, **fatrop_options) -> None:
         super().__init__(max_iterations, max_wall_time)
+        self.single_stage = single_stage
         self.options = {"print_level": 0, "max_iter": max_iterations, "tol": tol, **fatrop_options}
 
     def plugin_options(self, nlp: NLP) -> dict:
         if not nlp.exact_hessian:
             raise OptionError("fatrop needs the exact Hessian, and this NLP's dynamics backend gives first "
                               "derivatives only; use a symbolic backend (casadi, casadi-rnea) or another solver")
+        if not nlp.stages and not self.single_stage:
+            raise OptionError(STAGES_NEEDED.format(solver=self.name, what="this NLP"))
         equality = [bool(e) for e in np.asarray(nlp.lbg) == np.asarray(nlp.ubg)]
         structure = _stages(nlp.stages) if nlp.stages else _single_stage(nlp)
         return {"structure_detection": "manual", **structure, "equality": equality, "fatrop": self.options}

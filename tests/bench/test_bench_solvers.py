@@ -34,7 +34,7 @@ def test_bench_records_each_combination_and_sorts_by_solve_time(tmp_path, capsys
     scenarios.mkdir()
     shutil.copy(REPO / "scenarios/paper/case2.yaml", scenarios)
     rows = run_solver_benchmark(scenarios, tmp_path / "out", solvers=("ipopt", "fatrop"),
-                                dynamics=("casadi-rnea", "pinocchio"), knots=8)
+                                dynamics=("casadi-rnea", "pinocchio"), knots=8, transcription="hermite-simpson")
     with (tmp_path / "out/results.csv").open() as handle:
         reader = csv.DictReader(handle)
         assert tuple(reader.fieldnames) == RESULT_COLUMNS

@@ -4,6 +4,7 @@ each plans a paper case through `ocpkit.plan`."""
 
 from __future__ import annotations
 
+import functools
 import numpy as np
 import pytest
 from helpers import REPO
@@ -13,7 +14,14 @@ import ocpkit
 from ocpkit.errors import OptionError
 from ocpkit.solvers.base import SOLVERS, SolverStatus
 
-ALL_SOLVERS = {name: SOLVERS.get(name) for name in SOLVERS.names()}
+
+
+def for_toy_nlps(solver: type) -> type:
+    """`solver` for the toy NLPs, which have no stage structure: one dense stage where it needs stages."""
+    return functools.partial(solver, single_stage=True) if solver.needs_stages else solver
+
+
+ALL_SOLVERS = {name: for_toy_nlps(SOLVERS.get(name)) for name in SOLVERS.names()}
 
 @pytest.mark.parametrize("name", ALL_SOLVERS)
 def test_small_nlp_converges_to_the_known_optimum(name):
@@ -74,7 +82,8 @@ VERIFIES = {"ipopt", "sqpmethod", "pyomo", "scp"}
 @pytest.mark.parametrize("name", [name for name in ALL_SOLVERS if name != "ipopt"])
 def test_solver_plans_a_paper_case(name):
     problem = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
-    plan = ocpkit.plan(problem, knots=8, solver=name, solver_options={"max_wall_time": 15.0})
+    grid = {"transcription": "hermite-simpson"} if SOLVERS.get(name).needs_stages else {}  # staged by itself
+    plan = ocpkit.plan(problem, knots=8, solver=name, solver_options={"max_wall_time": 15.0}, **grid)
     print(f"{name}: {plan.status} t_f={plan.trajectory.tf:.4f} iterations={plan.stats.iterations}")
     assert plan.status in {"verified", "violated", "iteration_limit", "time_limit", "failed", "infeasible"}
     if name in VERIFIES:
@@ -92,3 +101,25 @@ def test_a_per_call_time_limit_overrides_the_solvers_own(name):
 def test_an_uninterruptible_solver_reports_an_overrun_of_the_per_call_limit(name):
     prepared = ALL_SOLVERS[name](max_wall_time=60.0, max_iterations=2).prepare(rosenbrock_disk())
     assert prepared.solve(GUESS, PARAMS, BOUNDS, max_wall_time=1e-9).status == SolverStatus.TIME_LIMIT
+
+
+CASE2 = REPO / "scenarios/paper/case2.yaml"
+
+
+@pytest.mark.parametrize("transcription", ["trapezoidal", "hermite-simpson"])
+def test_a_solver_that_needs_stages_gets_the_staged_nlp_by_name(transcription):
+    problem = ocpkit.load_scenario(CASE2)
+    assert ocpkit.build(problem, transcription, 6, solver="fatrop").discretization.nlp.stages is not None
+    assert ocpkit.build(problem, transcription, 6, solver="ipopt").discretization.nlp.stages is None
+
+
+@pytest.mark.parametrize("transcription, options", [("chebyshev", {}), ("lgr", {}),
+                                                    ("trapezoidal", {"staged": False})])
+def test_a_solver_that_needs_stages_refuses_an_nlp_without_them_saying_how_to_ask(transcription, options):
+    problem = ocpkit.load_scenario(CASE2)
+    with pytest.raises(OptionError, match="stage structure") as error:
+        ocpkit.build(problem, transcription, 6, solver="fatrop", transcription_options=options)
+    assert "single_stage" in str(error.value) and "\n" not in str(error.value)
+    unstaged = ocpkit.build(problem, transcription, 6, solver="fatrop", solver_options={"single_stage": True},
+                            transcription_options=options)
+    assert unstaged.discretization.nlp.stages is None  # asked for: one dense stage
