@@ -38,6 +38,31 @@ VIOLATED_HINTS = (
 
 
 @dataclass(frozen=True)
+class Hints:
+    """What a planner can change, by how its plan failed: `stopped` maps a status it stopped with to a hint,
+    `violated` pairs failed checks with a hint (most fundamental cause first), `failed` follows the solver's message.
+    Each planner names its own options (`finish(..., hints=...)`)."""
+
+    stopped: Mapping[str, str]
+    violated: tuple[tuple[tuple[str, ...], str], ...]
+    failed: str = "try another guess (guess=ompl) or solver"
+
+    def of(self, status: str, verification: Verification, solver_message: str) -> str:
+        """The hint of a plan that ended with `status`, its `verification` and the solver's message."""
+        if status == "failed":
+            return f"the solver failed ({solver_message}); {self.failed}"
+        if status in self.stopped:
+            return self.stopped[status]
+        failed = {c.name for c in verification.checks if not c.ok}
+        return next((hint for names, hint in self.violated if failed.intersection(names)),
+                    f"the plan ended with status {status}: {verification.summary()}")
+
+
+SIMULTANEOUS_HINTS = Hints(STOPPED_HINTS, VIOLATED_HINTS)
+"""The simultaneous planner's hints, the default of `finish`."""
+
+
+@dataclass(frozen=True)
 class SolveTiming:
     """One solve (the first, or a refinement round): the solver call's wall time (s), the dense verification's (s),
     its iterations, and the solver's own wall time (s) per NLP evaluation kind where it reports them
@@ -187,6 +212,7 @@ class Plan:
     stats: PlanStats
     method: dict
     found: bool = True
+    hints: Hints = field(default=SIMULTANEOUS_HINTS, compare=False, repr=False)
 
     @property
     def ok(self) -> bool:
@@ -200,26 +226,21 @@ class Plan:
             return ""
         if self.stats.hint is not None:  # a planner's own word (the fallback ladder's)
             return self.stats.hint
-        if self.status == "failed":
-            return f"the solver failed ({self.stats.solver_message}); try another guess (guess=ompl) or solver"
-        if self.status in STOPPED_HINTS:
-            return STOPPED_HINTS[self.status]
-        failed = {c.name for c in self.verification.checks if not c.ok}
-        return next((hint for names, hint in VIOLATED_HINTS if failed.intersection(names)),
-                    f"the plan ended with status {self.status}: {self.verification.summary()}")
+        return self.hints.of(self.status, self.verification, self.stats.solver_message)
 
 
 def finish(problem: Problem, trajectory: Trajectory, stopped: str | None, method: dict, started: float, *,
            setup_time: float = 0.0, iterations: int = 0, rounds: int = 0, message: str = "",
            timing: Timing | None = None, screening: Screening | None = None, path: PathStats | None = None,
-           extra: dict | None = None, verification: Verification | None = None, found: bool = True) -> Plan:
+           extra: dict | None = None, verification: Verification | None = None, found: bool = True,
+           hints: Hints = SIMULTANEOUS_HINTS) -> Plan:
     """The Plan of `trajectory` for `problem`. `stopped` is the planner's word when it did not finish (then it is
     the status), None when it did (then the status is `verified` or `violated`, as the dense verification says;
     `verification` is computed here unless given). `started` is the time.perf_counter() when planning began:
     the computation time runs until now, less `setup_time`. `timing`, `screening`, `path`, `extra`: see
-    `PlanStats`; `found`: see `Plan`."""
+    `PlanStats`; `found`: see `Plan`; `hints`: what this planner can change when the plan fails (`Hints`)."""
     verification = verification or verify(problem, trajectory)
     status = stopped or ("verified" if verification.ok else "violated")
     stats = PlanStats(time.perf_counter() - started - setup_time, setup_time, iterations, rounds, message,
                       timing or Timing(), screening=screening, path=path, extra=extra or {})
-    return Plan(trajectory, status, verification, stats, method, found)
+    return Plan(trajectory, status, verification, stats, method, found, hints)

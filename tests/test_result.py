@@ -225,3 +225,16 @@ def test_a_verified_plan_has_no_hint(motion):
 def test_a_plan_has_a_trajectory_unless_the_planner_says_it_found_none(motion):
     assert finish(FREE, motion, None, {}, 0.0, verification=PASSED).found
     assert not finish(FREE, motion, "no_path", {}, 0.0, verification=PASSED, found=False).found
+
+
+def test_each_planner_hints_at_what_it_can_change():
+    from ocpkit.baselines.ompl_topp3 import TOPP3_HINTS
+    from ocpkit.baselines.ompl_toppra import TOPPRA_HINTS
+    from ocpkit.result import SIMULTANEOUS_HINTS
+
+    rate = Verification((Check("torque_rate", 3.0, 0.01, 0.2, "rel"),), np.zeros(0))
+    assert "ompl-topp3" in TOPPRA_HINTS.of("violated", rate, "")
+    assert "knots" in TOPP3_HINTS.of("violated", rate, "") and "knots" in SIMULTANEOUS_HINTS.of("violated", rate, "")
+    contact = Verification((Check("obstacle", 0.01, 0.0, 0.2, "m"),), np.zeros(0))
+    assert "margin" in TOPP3_HINTS.of("violated", contact, "") and "knots" not in TOPP3_HINTS.of("violated", contact, "")
+    assert "max_iterations" in TOPP3_HINTS.of("iteration_limit", rate, "")

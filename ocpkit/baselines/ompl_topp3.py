@@ -27,6 +27,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ocpkit.baselines.ompl_toppra import CONTACT_HINT, NO_PATH_HINT
 from ocpkit.dynamics import Dynamics
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import PathSpline
@@ -44,9 +45,26 @@ from ocpkit.planner.ompl_seed import (
 )
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, Refined, solve_refined
 from ocpkit.problem import Problem
-from ocpkit.result import PathStats, Plan, Timing, finish
+from ocpkit.result import Hints, PathStats, Plan, Timing, finish
 from ocpkit.solvers import SolverStatus
 from ocpkit.transcription.ocp import PathTimingOCP
+from ocpkit.verify import GEOMETRY_CHECKS, SCALED_LIMITS
+
+TOPP3_HINTS = Hints(
+    stopped={"no_path": NO_PATH_HINT,
+             "infeasible": "the timing is locally infeasible along this path: try another seed (another path)",
+             "iteration_limit": "the timing solve reached its iteration limit: raise max_iterations "
+                                "(solver_options) or try another seed (another path)",
+             "time_limit": "the timing solve reached max_wall_time: raise it"},
+    violated=((("motion_time",), "the timing solve diverged: try another solver"),
+              (("dynamics", "qd_consistency", "qdd_consistency"),
+               "the interpolant does not resolve the dynamics between knots: use more knots or segments"),
+              (GEOMETRY_CHECKS, CONTACT_HINT),
+              (("position", *SCALED_LIMITS), "a limit is exceeded between the timing's check times: use more knots "
+                                            "or refinements"),
+              (("boundary",), "the motion does not start and end at rest: check the timing's boundary conditions")),
+    failed="try another solver or seed")
+"""What `ompl-topp3` can change: its path search and smoothing, and its timing OCP's grid and solver."""
 
 PIECES_STEP = 4  # the path's polynomial pieces are rounded up to a multiple of this: one NLP per multiple
 TIMING_CONSTRAINTS = ("state-limits", "torque", "torque-rate")
@@ -146,7 +164,8 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     method = {"planner": "ompl-topp3", "path_planner": planner_name, "transcription": transcription, "knots": knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": solver}
     if np.array_equal(problem.start, problem.goal):
-        return finish(problem, hold(problem), None, method, began, message="the goal is the start: hold still")
+        return finish(problem, hold(problem), None, method, began, message="the goal is the start: hold still",
+                      hints=TOPP3_HINTS)
     setup = import_backends()
     free = planning_space(problem, margin)
     found = ompl_path(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
@@ -154,7 +173,8 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     if found.waypoints is None:
         return finish(problem, hold(problem), "no_path", method, began, setup_time=setup, timing=searched,
                       path=PathStats(free.checks, 0, 0, free.margin), found=False,
-                      message=f"{no_path_message(planner_name, planning_time, free)}; the plan holds the start")
+                      message=f"{no_path_message(planner_name, planning_time, free)}; the plan holds the start",
+                      hints=TOPP3_HINTS)
     smoothing = time.perf_counter()
     smooth, rounds = smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
     smoothed = time.perf_counter()
@@ -168,4 +188,4 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + timing.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=message, timing=spent,
                   path=PathStats(free.checks, len(found.waypoints), rounds, free.margin, timing.toppra_tf),
-                  verification=refined.verification)
+                  verification=refined.verification, hints=TOPP3_HINTS)

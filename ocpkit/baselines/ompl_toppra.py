@@ -21,7 +21,25 @@ from ocpkit.planner.ompl_seed import (
     planning_space,
 )
 from ocpkit.problem import Problem
-from ocpkit.result import Plan, finish
+from ocpkit.result import Hints, Plan, finish
+from ocpkit.verify import GEOMETRY_CHECKS
+
+NO_PATH_HINT = "OMPL found no path within its budget, so there is no trajectory: raise planning_time or max_checks"
+CONTACT_HINT = ("the smoothed path comes into contact between its collision checks: lower resolution or raise "
+                "margin")
+TOPPRA_HINTS = Hints(
+    stopped={"no_path": NO_PATH_HINT,
+             "infeasible": "TOPP-RA cannot time this path within the velocity and torque limits: try another seed "
+                           "(another path)"},
+    violated=((("motion_time",), "the timed motion lies outside the time bounds: check time.min and time.max"),
+              (GEOMETRY_CHECKS, CONTACT_HINT),
+              (("torque_rate",), "TOPP-RA does not bound the torque rate: plan with ompl-topp3, which times the same "
+                                 "path under every limit"),
+              (("position", "velocity", "torque", "dynamics", "qd_consistency", "qdd_consistency"),
+               "TOPP-RA holds the limits at its grid points only: raise grid_points"),
+              (("boundary",), "the motion does not start and end at rest: the path's end tangents are not zero")),
+    failed="try another seed (another path)")
+"""What `ompl-toppra` can change: its path search, smoothing and TOPP-RA grid; the torque rate it cannot bound."""
 
 
 def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
@@ -42,9 +60,9 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
     if seeded.trajectory is None:
         return finish(problem, hold(problem), seeded.stopped, method, began, setup_time=seeded.setup_time,
                       message=f"{seeded.message}; no trajectory: the plan holds the start", timing=seeded.timing,
-                      path=seeded.path, found=False)
+                      path=seeded.path, found=False, hints=TOPPRA_HINTS)
     return finish(problem, seeded.trajectory, None, method, began, setup_time=seeded.setup_time,
-                  message=seeded.message, timing=seeded.timing, path=seeded.path)
+                  message=seeded.message, timing=seeded.timing, path=seeded.path, hints=TOPPRA_HINTS)
 
 
 def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,

@@ -191,3 +191,12 @@ def test_ompl_plans_with_at_most_half_the_ends_clearance_as_margin():
     assert planning_space(cage, 0.01).margin == pytest.approx(0.5 * ends)
     case2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")  # clear ends: the margin as asked
     assert planning_space(case2, 0.01).margin == 0.01
+
+
+def test_a_violated_plan_names_what_this_planner_can_change():
+    """The baseline cannot bound the torque rate, and has no knots or refinements: its hint names ompl-topp3."""
+    problem = ocpkit.load_scenario(REPO / "scenarios/paper/case1.yaml")
+    plan = ocpkit.plan(problem, planner="ompl-toppra")
+    failed = {c.name for c in plan.verification.checks if not c.ok}
+    assert plan.status == "violated" and "torque_rate" in failed
+    assert "ompl-topp3" in plan.hint and "knots" not in plan.hint
