@@ -4,12 +4,15 @@
 building both on first use. The key is the transcription's options, the dynamics backend (its robot's content
 included), each constraint's shape, the solver and its options: start, goal, time bounds, μ and obstacle
 positions are numbers, so queries that differ only in them share a build. The cache holds the most recently used
-`CACHE_SIZE` builds.
+builds within a memory budget (`memory_budget`): each build's size is estimated as the growth of the process's
+resident memory while it was made, and the least recently used builds are dropped while the estimates add up to
+more than the budget (the newest always stays).
 """
 
 from __future__ import annotations
 
 import inspect
+import os
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
@@ -17,6 +20,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import psutil
 
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics, make_dynamics
@@ -29,7 +33,10 @@ from ocpkit.solvers.compiled import compile_seconds
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
 
-CACHE_SIZE = 8  # builds (each holds an NLP graph and a prepared solver: large for a 7-joint arm)
+MEMORY_BUDGET = 2 * 1024**3
+"""Bytes the cached builds of one process may hold by default ($OCPKIT_BUILD_MEMORY_MB overrides)."""
+SMALLEST_BUILD = 1024**2
+"""Bytes a build is counted as at least (memory freed by an evicted build can be reused by the next one)."""
 
 
 @dataclass(frozen=True)
@@ -43,6 +50,7 @@ class Build:
     solver: PreparedSolver
     setup_time: float
     setup_parts: dict = field(default_factory=dict)
+    nbytes: int = 0  # estimated memory held, bytes (0 when it came from the cache)
 
 
 _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
@@ -66,16 +74,38 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     if key in _BUILDS:
         _BUILDS.move_to_end(key)
         return Build(_BUILDS[key].discretization, _BUILDS[key].solver, 0.0)
-    began = time.perf_counter()
+    began, resident = time.perf_counter(), _resident()
     discretization = method.build(problem, backend, plugins, ocp)
     built, compiling = time.perf_counter(), compile_seconds()
     prepared = nlp_solver.prepare(discretization.nlp)
     ended, compiled = time.perf_counter(), compile_seconds() - compiling
     _BUILDS[key] = Build(discretization, prepared, ended - began,
-                         {"graph": built - began, "solver": ended - built - compiled, "compile": compiled})
-    while len(_BUILDS) > CACHE_SIZE:
+                         {"graph": built - began, "solver": ended - built - compiled, "compile": compiled},
+                         max(_resident() - resident, SMALLEST_BUILD))
+    while len(_BUILDS) > 1 and sum(b.nbytes for b in _BUILDS.values()) > memory_budget():
         _BUILDS.popitem(last=False)
     return _BUILDS[key]
+
+
+def memory_budget() -> int:
+    """Bytes the cached builds may hold: $OCPKIT_BUILD_MEMORY_MB (MiB) if set, else MEMORY_BUDGET."""
+    given = os.environ.get("OCPKIT_BUILD_MEMORY_MB")
+    if given is None:
+        return MEMORY_BUDGET
+    try:
+        return int(float(given) * 1024**2)
+    except ValueError:
+        raise OptionError(f"OCPKIT_BUILD_MEMORY_MB must be a number of MiB, got {given!r}") from None
+
+
+def cached_bytes() -> int:
+    """The estimated bytes the cached builds hold now."""
+    return sum(b.nbytes for b in _BUILDS.values())
+
+
+def _resident() -> int:
+    """This process's resident memory, bytes."""
+    return psutil.Process().memory_info().rss
 
 
 def _staged_for(solver: str, solver_options: dict, transcription: str, transcription_options: dict) -> dict:

@@ -106,8 +106,10 @@ def test_an_unchanged_copy_of_the_robot_files_shares_the_build(tmp_path):
     assert ocpkit.build(dataclasses.replace(PROBLEM, robot=copy), knots=6).discretization is first.discretization
 
 
-def test_the_cache_keeps_the_most_recently_used_builds(monkeypatch):
-    monkeypatch.setattr(build_cache, "CACHE_SIZE", 2)
+def test_the_cache_keeps_the_most_recently_used_builds_within_its_memory_budget(monkeypatch):
+    clear_builds()
+    monkeypatch.setattr(build_cache, "SMALLEST_BUILD", 400 * 1024**2)  # every build counts as 400 MiB
+    monkeypatch.setenv("OCPKIT_BUILD_MEMORY_MB", "900")  # room for two
     a = ocpkit.build(PROBLEM, knots=6).discretization
     b = ocpkit.build(PROBLEM, knots=7).discretization
     assert ocpkit.build(PROBLEM, knots=6).discretization is a  # a is now the most recent
@@ -146,3 +148,19 @@ def test_an_unknown_solver_is_named_before_any_build(monkeypatch):
     monkeypatch.setattr(Pseudospectral, "build", lambda *args: pytest.fail("built an NLP for an unknown solver"))
     with pytest.raises(RegistryError, match="unknown solver 'nope'"):
         ocpkit.build(PROBLEM, knots=7, solver="nope")
+
+
+def test_the_newest_build_stays_even_past_the_budget(monkeypatch):
+    clear_builds()
+    monkeypatch.setenv("OCPKIT_BUILD_MEMORY_MB", "0")
+    first = ocpkit.build(PROBLEM, knots=6)
+    assert first.nbytes >= build_cache.SMALLEST_BUILD and build_cache.cached_bytes() == first.nbytes
+    assert ocpkit.build(PROBLEM, knots=6).discretization is first.discretization
+    ocpkit.build(PROBLEM, knots=7)
+    assert ocpkit.build(PROBLEM, knots=6).discretization is not first.discretization
+
+
+def test_a_budget_that_is_no_number_is_named(monkeypatch):
+    monkeypatch.setenv("OCPKIT_BUILD_MEMORY_MB", "lots")
+    with pytest.raises(OptionError, match="OCPKIT_BUILD_MEMORY_MB"):
+        build_cache.memory_budget()
