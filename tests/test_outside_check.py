@@ -74,3 +74,15 @@ def test_outside_box_and_cylinder_distances_match_coal():
                            for p in points])
         assert (theirs < 0).sum() > 10 and (theirs > 0).sum() > 10
         np.testing.assert_allclose(ours, theirs, atol=1e-4)
+
+
+def test_the_json_records_every_check_with_its_tolerance(tmp_path):
+    motion = polynomial_motion(FREE, 3.0, MINIMUM_JERK)
+    plan = finish(FREE, motion, None, {}, 0.0)
+    header = trajectory_header(FREE, plan)
+    write_json(tmp_path / "t.json", motion, header)
+    checks = {c["name"]: c for c in __import__("json").loads((tmp_path / "t.json").read_text())["checks"]}
+    assert set(checks) == {c.name for c in plan.verification.checks}
+    assert checks["position"]["tolerance"] == 1e-4 and checks["position"]["unit"] == "rad"
+    assert checks["velocity"]["tolerance"] == 0.01 and checks["obstacle"]["tolerance"] == 0.0
+    assert checks["position"]["where"] in FREE.robot.joint_names

@@ -16,10 +16,13 @@ RESULT_COLUMNS = (*KEY_COLUMNS, "status", "tf", "solve_time_s", "setup_time_s", 
 
 
 def trajectory_header(problem: Problem, plan: Plan) -> dict:
-    """Header fields of the trajectory JSON for `plan`."""
+    """Header fields of the trajectory JSON for `plan`, its verification's checks with their tolerances
+    included."""
     return {"robot": problem.robot.name, "joint_names": list(problem.robot.joint_names), "method": plan.method,
             "status": plan.status, "found": plan.found, "solve_time_s": plan.stats.solve_time,
-            "iterations": plan.stats.iterations}
+            "setup_time_s": plan.stats.setup_time, "iterations": plan.stats.iterations,
+            "checks": [{"name": c.name, "worst": c.worst, "tolerance": c.tolerance, "unit": c.unit, "time_s": c.time,
+                        "where": c.where} for c in plan.verification.checks]}
 
 
 def result_row(suite: str, case: str, plan: Plan, solve_time: float, setup_time: float) -> dict:

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-FORMAT = "ocpkit.formats.trajectory/1"
+FORMAT = "ocpkit.trajectory/1"
 TIME_TOLERANCE = 0.01  # relative excess of t_f over its time bounds that still counts as inside
 MAX_SAMPLES = 100_000  # dense samples a trajectory file holds at most (100 s at 1 ms)
 

@@ -63,7 +63,7 @@ def test_exported_json_passes_the_outside_check(tmp_path):
     path = tmp_path / "case1.json"
     ocpkit.write_json(path, result.trajectory, trajectory_header(problem, result))
     document = json.loads(path.read_text())
-    assert document["format"] == "ocpkit.formats.trajectory/1" and document["status"] == "verified"
+    assert document["format"] == "ocpkit.trajectory/1" and document["status"] == "verified"
     assert document["samples"]["t"][1] == pytest.approx(0.001)
     assert document["samples"]["t"][-1] == pytest.approx(document["tf"])
     check = subprocess.run([sys.executable, str(REPO / "tests/outside_check.py"), str(path), str(DATA / "spec.yaml"),

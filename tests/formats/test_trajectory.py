@@ -60,7 +60,7 @@ def test_write_json_writes_the_documented_fields(tmp_path):
     write_json(path, linear(0.0105), HEADER, dt=1e-3)
     document = json.loads(path.read_text())
     assert set(document) == {"format", *HEADER, "tf", "knots", "samples"}
-    assert document["format"] == FORMAT == "ocpkit.formats.trajectory/1"
+    assert document["format"] == FORMAT == "ocpkit.trajectory/1"
     assert {k: document[k] for k in HEADER} == HEADER
     assert document["tf"] == 0.0105
     assert set(document["knots"]) == {"t", "q", "qd", "tau"}
