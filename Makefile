@@ -18,6 +18,7 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 demo: $(VENV)/.installed compiler
 	$(BIN)/ocpkit bench paper --out $(OUT)
 
+# pytest's options are in pyproject.toml: one pytest-xdist worker per CPU, the 20 slowest tests listed.
 test: $(VENV)/.installed chromium compiler
 	$(BIN)/python -m pytest -q
 

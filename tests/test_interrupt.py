@@ -56,6 +56,7 @@ def test_a_new_watch_forgets_an_old_interrupt():
         interrupt.check()
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_plan_exits_130_with_one_line_and_no_file(tmp_path):
     out = tmp_path / "out.json"
     process = subprocess.Popen([*OCPKIT, "plan", str(REPO / "scenarios/paper/case1.yaml"), "--solver", "sqpmethod",

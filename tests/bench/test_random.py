@@ -42,10 +42,12 @@ def test_the_obstacles_are_in_the_way_of_the_straight_path():
 
 def test_problems_without_room_to_pass_are_redrawn(monkeypatch):
     """A problem whose certificate finds no path is replaced by the next draw; the others are kept as drawn."""
-    drawn = list(random_problems(100, 3, (1, 3), room_to_pass=False))
-    certified = list(random_problems(100, 2, (1, 3)))
+    # seed 10: its first draws are certified at once (seed 100's second exhausts the certificate's budget, ~40 s)
+    drawn = list(random_problems(10, 3, (1, 3), room_to_pass=False))
+    certified = list(random_problems(10, 2, (1, 3)))
     assert [p.name for p in certified] == ["random2", "random1"]
     np.testing.assert_array_equal(certified[0].start, drawn[0].start)
+    np.testing.assert_array_equal(certified[1].start, drawn[1].start)
     calls = []
 
     def no_path_first(problem, **options):
@@ -53,7 +55,7 @@ def test_problems_without_room_to_pass_are_redrawn(monkeypatch):
         return None if len(calls) == 1 else np.stack([problem.start, problem.goal])
 
     monkeypatch.setattr(suite, "joint_path", no_path_first)
-    redrawn = list(random_problems(100, 2, (1, 3)))
+    redrawn = list(random_problems(10, 2, (1, 3)))
     np.testing.assert_array_equal(redrawn[0].start, drawn[1].start)
     np.testing.assert_array_equal(redrawn[1].start, drawn[2].start)
     assert calls[0]["seed"] == suite.PATH_SEED and calls[0]["max_checks"] == suite.PATH_CHECKS

@@ -87,8 +87,9 @@ def test_an_unreachable_scheduler_is_one_error_line(tmp_path, capsys, monkeypatc
     assert "--scheduler tcp://127.0.0.1:1: cannot connect" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uninterrupted_run(tmp_path):
-    suite, out = write_suite(tmp_path, repeats=3), tmp_path / "out"
+    suite, out = write_suite(tmp_path, repeats=2), tmp_path / "out"  # 8 rows
     command = [sys.executable, "-m", "ocpkit.cli.main", "bench", "run", str(suite), "--out", str(out), "--jobs", "2"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     results = out / "results.csv"
@@ -98,10 +99,10 @@ def test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows_of_an_uni
     stdout, stderr = process.communicate(timeout=60)
     kept = read_rows(results)
     assert process.returncode == 130, stderr
-    assert 2 <= len(kept) < 12 and "interrupted:" in stdout
+    assert 2 <= len(kept) < 8 and "interrupted:" in stdout
     assert main(["bench", "run", str(suite), "--out", str(out)]) == 0
     resumed = read_rows(results)
-    assert len(resumed) == 12 and comparable(resumed[:len(kept)]) == comparable(kept)
+    assert len(resumed) == 8 and comparable(resumed[:len(kept)]) == comparable(kept)
     fresh = tmp_path / "fresh"
     run_suite(suite, fresh, progress=False)
     assert comparable(resumed) == comparable(read_rows(fresh / "results.csv"))
@@ -182,10 +183,12 @@ def test_mbm_problems_resolve_to_the_shipped_scene_folder_in_natural_order(tmp_p
 
 
 def test_random_source_and_repeats_give_seeded_problems_and_seeds(tmp_path):
-    (tmp_path / "s.yaml").write_text("scenarios: [{random: {count: 2, seed: 3, obstacles: [1, 2]}}]\n"
+    # seed 5: its first two draws are certified at once (seed 3's second draw exhausts the certificate's budget,
+    # ~40 s per load; redrawing is tests/bench/test_random.py's)
+    (tmp_path / "s.yaml").write_text("scenarios: [{random: {count: 2, seed: 5, obstacles: [1, 2]}}]\n"
                                      "methods: [{planner: ompl-toppra, seed: 5}]\nrepeats: 2")
     suite = load_suite(tmp_path / "s.yaml")
-    assert [s.scene for s in suite.scenarios] == ["random-seed3"] * 2
+    assert [s.scene for s in suite.scenarios] == ["random-seed5"] * 2
     assert [suite.methods[0].plan_options(r)[1] for r in range(2)] == [5, 6]
     assert load_suite(tmp_path / "s.yaml").scenarios == suite.scenarios  # deterministic in the seed
 
@@ -230,22 +233,24 @@ def test_bad_run_options_are_one_error_line(tmp_path, capsys, arguments, message
 def test_the_paper_suite_gives_the_same_rows_with_jobs_2_on_a_local_cluster_and_interrupted(tmp_path):
     from dask.distributed import LocalCluster
 
-    suite = REPO / "suites/paper.yaml"
-    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "jobs"), "--jobs", "2"]) == 0
+    # the shipped suite with 1 of its 3 repeats: 8 rows a run, not 24 (the repeats and their OMPL seeds the same
+    # whether serial, in jobs or interrupted: test_ctrl_c_keeps_the_finished_rows_and_a_rerun_ends_with_the_rows...)
+    suite, repeats = REPO / "suites/paper.yaml", ["--repeats", "1"]
+    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "jobs"), "--jobs", "2", *repeats]) == 0
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        run_suite(suite, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False)
+        run_suite(suite, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False, repeats=1)
     command = [sys.executable, "-m", "ocpkit.cli.main", "bench", "run", str(suite), "--out", str(tmp_path / "cut"),
-               "--jobs", "2"]
+               "--jobs", "2", *repeats]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     results = tmp_path / "cut" / "results.csv"
-    while process.poll() is None and not (results.exists() and len(read_rows(results)) >= 5):
+    while process.poll() is None and not (results.exists() and len(read_rows(results)) >= 2):
         time.sleep(0.05)
     process.send_signal(signal.SIGINT)
     process.communicate(timeout=60)
-    assert process.returncode == 130 and len(read_rows(results)) < 24
-    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "cut"), "--jobs", "2"]) == 0
+    assert process.returncode == 130 and len(read_rows(results)) < 8
+    assert main(["bench", "run", str(suite), "--out", str(tmp_path / "cut"), "--jobs", "2", *repeats]) == 0
     jobs = comparable(read_rows(tmp_path / "jobs" / "results.csv"))
-    assert len(jobs) == 24
+    assert len(jobs) == 8
     assert comparable(read_rows(tmp_path / "dask" / "results.csv")) == jobs
     assert comparable(read_rows(results)) == jobs
     assert main(["report", str(tmp_path / "cut")]) == 0

@@ -152,9 +152,12 @@ def test_a_diverging_solver_stops_early_and_writes_a_small_file(tmp_path):
     from ocpkit.bench.random import random_problems
 
     problem = list(random_problems(1, 3))[2]
-    began = time.perf_counter()
+    began, began_cpu = time.perf_counter(), time.process_time()
     result = ocpkit.plan(problem, knots=12, solver="sqpmethod", max_wall_time=60.0, fallbacks=SINGLE_SHOT)
-    assert time.perf_counter() - began < 61.0 + result.stats.setup_time
+    # its one QP takes ~30 s of CPU and cannot be interrupted: on a machine shared with other processes the wall time
+    # stretches past the limit, the CPU time does not (one thread); an overrun by work (before issue 10) shows in both
+    took = min(time.perf_counter() - began, time.process_time() - began_cpu)
+    assert took < 61.0 + result.stats.setup_time
     assert result.status in ("failed", "time_limit") and not result.ok
     path = tmp_path / "diverged.json"
     ocpkit.write_json(path, result.trajectory, trajectory_header(problem, result),

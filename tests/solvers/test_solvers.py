@@ -78,8 +78,8 @@ VERIFIES = {"ipopt", "sqpmethod", "pyomo", "scp"}
 """Solvers that reliably verify case 2 at 8 knots; the others must end in a reported status."""
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("name", [name for name in ALL_SOLVERS if name != "ipopt"])
+@pytest.mark.slow  # scp: tests/solvers/test_scp.py plans the same case at 8 knots and also compares t_f with ipopt's
+@pytest.mark.parametrize("name", [name for name in ALL_SOLVERS if name not in ("ipopt", "scp")])
 def test_solver_plans_a_paper_case(name):
     problem = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
     grid = {"transcription": "hermite-simpson"} if SOLVERS.get(name).needs_stages else {}  # staged by itself
