@@ -34,15 +34,8 @@ from ocpkit.formats.trajectory import TIME_TOLERANCE, Samples, Trajectory, time_
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
-from ocpkit.tolerances import (
-    BOUNDARY_TOLERANCE,
-    DYNAMICS_TOLERANCE,
-    GEOMETRY_TOLERANCE,
-    LIMIT_TOLERANCE,
-    POSITION_TOLERANCE,
-    QD_CONSISTENCY_TOLERANCE,
-    QDD_CONSISTENCY_TOLERANCE,
-)
+from ocpkit.tolerances import (BOUNDARY_TOLERANCE, DYNAMICS_TOLERANCE, GEOMETRY_TOLERANCE, LIMIT_TOLERANCE,
+                               POSITION_TOLERANCE, QD_CONSISTENCY_TOLERANCE, QDD_CONSISTENCY_TOLERANCE)
 
 GEOMETRY_CHECKS = ("self_collision", "obstacle", "workspace")
 SCALED_LIMITS = ("velocity", "torque", "torque_rate")

@@ -17,15 +17,7 @@ from ocpkit.formats.record import Recorded, result_row
 from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Scene
 from ocpkit.planner import PLANNERS
-from ocpkit.result import (
-    PathStats,
-    PlanStats,
-    RungRow,
-    Screening,
-    SolveTiming,
-    Timing,
-    finish,
-)
+from ocpkit.result import PathStats, PlanStats, RungRow, Screening, SolveTiming, Timing, finish
 from ocpkit.verify import Check, Verification
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -236,5 +228,6 @@ def test_each_planner_hints_at_what_it_can_change():
     assert "ompl-topp3" in TOPPRA_HINTS.of("violated", rate, "")
     assert "knots" in TOPP3_HINTS.of("violated", rate, "") and "knots" in SIMULTANEOUS_HINTS.of("violated", rate, "")
     contact = Verification((Check("obstacle", 0.01, 0.0, 0.2, "m"),), np.zeros(0))
-    assert "margin" in TOPP3_HINTS.of("violated", contact, "") and "knots" not in TOPP3_HINTS.of("violated", contact, "")
+    contact_hint = TOPP3_HINTS.of("violated", contact, "")
+    assert "margin" in contact_hint and "knots" not in contact_hint
     assert "max_iterations" in TOPP3_HINTS.of("iteration_limit", rate, "")

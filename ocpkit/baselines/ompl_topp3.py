@@ -32,17 +32,8 @@ from ocpkit.dynamics import Dynamics
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import PathSpline
 from ocpkit.planner.build_cache import build
-from ocpkit.planner.ompl_seed import (
-    MAX_STEP,
-    check_ompl_planner,
-    hold,
-    import_backends,
-    no_path_message,
-    ompl_path,
-    planning_space,
-    smooth_path,
-    time_optimal,
-)
+from ocpkit.planner.ompl_seed import (MAX_STEP, check_ompl_planner, hold, import_backends, no_path_message, ompl_path,
+                                      planning_space, smooth_path, time_optimal)
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, Refined, solve_refined
 from ocpkit.problem import Problem
 from ocpkit.result import Hints, PathStats, Plan, Timing, finish

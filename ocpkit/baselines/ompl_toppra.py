@@ -12,14 +12,7 @@ import time
 
 import numpy as np
 
-from ocpkit.planner.ompl_seed import (
-    MAX_STEP,
-    SeedOptions,
-    hold,
-    ompl_path,
-    ompl_seed,
-    planning_space,
-)
+from ocpkit.planner.ompl_seed import MAX_STEP, SeedOptions, hold, ompl_path, ompl_seed, planning_space
 from ocpkit.problem import Problem
 from ocpkit.result import Hints, Plan, finish
 from ocpkit.verify import GEOMETRY_CHECKS

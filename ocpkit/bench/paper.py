@@ -16,22 +16,8 @@ import statistics
 from dataclasses import dataclass
 from pathlib import Path
 
-from ocpkit.bench.common import (
-    Results,
-    load_all,
-    machine,
-    measure,
-    reported_on_interrupt,
-    resumed_line,
-)
-from ocpkit.formats.record import (
-    KEY_COLUMNS,
-    RESULT_COLUMNS,
-    Recorded,
-    result_row,
-    row_key,
-    trajectory_header,
-)
+from ocpkit.bench.common import Results, load_all, machine, measure, reported_on_interrupt, resumed_line
+from ocpkit.formats.record import KEY_COLUMNS, RESULT_COLUMNS, Recorded, result_row, row_key, trajectory_header
 from ocpkit.formats.trajectory import write_json
 from ocpkit.planner.ladder import SINGLE_SHOT
 from ocpkit.problem import Problem
@@ -193,7 +179,8 @@ def _comparison(problems: list[Problem], measured: dict, dynamics: tuple[str, ..
 
 
 def _guess_table(problems: list[Problem], paper: dict, default: dict, counts: tuple[int, ...]) -> str:
-    """The paper's guess (straight line, t_f = time.guess) beside the timed line (ocpkit.planner.guesses) per knot count."""
+    """The paper's guess (straight line, t_f = time.guess) beside the timed line (ocpkit.planner.guesses) per knot
+    count."""
     lines = ["", f"Initial guess: the paper's ({PAPER_GUESS}: straight line over t_f = time.guess) vs the timed line "
              f"({TIMED_GUESS}: straight line over a velocity/torque estimate of t_f), single shot",
              f"{'guess':<8}{'knots':>6}{'median computation':>20}{'iterations':>12}{'per case':>18}{'verified':>10}"]

@@ -178,8 +178,8 @@ def summary_table(splits: dict[str, dict[int, list[Sample]]]) -> str:
              f"{'verified':>10}{'set-up':>9}{'graph':>8}{'solver':>8}{'compile':>9}{'paper':>7}"]
     for guess, split in splits.items():
         lines += [f"{guess:<7}" + _summary_row(n, samples) for n, samples in split.items()]
-    lines.append("line: the timed line guess (ocpkit.planner.guesses); paper: the paper's (straight line over t_f = 10 s); "
-                 "compile: C compiled in the set-up, 0 when the disk cache had it")
+    lines.append("line: the timed line guess (ocpkit.planner.guesses); paper: the paper's (straight line over "
+                 "t_f = 10 s); compile: C compiled in the set-up, 0 when the disk cache had it")
     return "\n".join(lines)
 
 

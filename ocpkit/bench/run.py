@@ -17,13 +17,7 @@ from tqdm import tqdm
 from ocpkit.bench.common import Results, reported_on_interrupt, resumed_line
 from ocpkit.bench.metrics import formatted, summarize
 from ocpkit.bench.suite import load_suite
-from ocpkit.bench.task import (
-    RUN_COLUMNS,
-    RUN_KEY_COLUMNS,
-    make_task,
-    run_task,
-    task_key,
-)
+from ocpkit.bench.task import RUN_COLUMNS, RUN_KEY_COLUMNS, make_task, run_task, task_key
 from ocpkit.bench.workers import in_processes
 from ocpkit.errors import OptionError
 

@@ -30,18 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from ocpkit.errors import OcpkitError, within
-from ocpkit.formats.schema import (
-    Choice,
-    Mapping,
-    Number,
-    Sequence,
-    String,
-    Tagged,
-    check,
-    read_bytes,
-    read_yaml,
-    show,
-)
+from ocpkit.formats.schema import Choice, Mapping, Number, Sequence, String, Tagged, check, read_bytes, read_yaml, show
 
 
 class SuiteError(OcpkitError):
@@ -236,9 +225,7 @@ def _rejected(scene: Path) -> dict[str, str]:
 
 
 def _random(body: dict, base: Path, where: str) -> tuple[list[Scenario], list[str]]:
-    from ocpkit.bench.random import (
-        _scenario as scenario_data,  # the random suite's own file content
-    )
+    from ocpkit.bench.random import _scenario as scenario_data  # the random suite's own file content
     from ocpkit.bench.random import random_problems
 
     seed, low_high = body.get("seed", 1), tuple(body.get("obstacles", (1, 1)))

@@ -57,7 +57,8 @@ def trajectory_file(task: dict) -> str:
 
 def _guess_and_seed(planner: str, options: dict, seed: int | None, rung_name: str | None) -> tuple[str, int | None]:
     """The initial guess and OMPL seed of the plan a row reports: for the simultaneous planner, those of the
-    fallback-ladder rung that gave it (ocpkit.planner.ladder) where the rung overrides the method's; no guess otherwise."""
+    fallback-ladder rung that gave it (ocpkit.planner.ladder) where the rung overrides the method's; no guess
+    otherwise."""
     if planner != "simultaneous":
         return "", seed
     rung = next((r for r in options.get("fallbacks", DEFAULT_LADDER) if r.name == rung_name), None)

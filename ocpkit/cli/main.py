@@ -240,8 +240,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--max-wall-time", type=float, help="time limit of the whole plan, s (ompl-toppra: OMPL's "
                    "planning time, default 1)")
     p.add_argument("--single-shot", action="store_true", help="simultaneous: one solve with the given options, "
-                   "no fallback ladder (the paper's setting; default: the ladder of ocpkit.planner.ladder, first verified "
-                   "rung wins)")
+                   "no fallback ladder (the paper's setting; default: the ladder of ocpkit.planner.ladder, first "
+                   "verified rung wins)")
     p.add_argument("--mu", type=float, default=None, help="jerk weight μ ≥ 0 (default: the scenario's)")
     p.add_argument("-o", "--output", help="write the trajectory JSON here (checked before planning; not written "
                    "when interrupted)")

@@ -7,7 +7,8 @@ Read: `world.collision_objects` (boxes, spheres and cylinders; each primitive's 
 tolerances, other joints, planner settings, the allowed-collision matrix, ...) is listed in `Conversion.ignored`.
 Poses are taken in the world frame whatever `header.frame_id` says (noted when it names another frame).
 Positions are `[x, y, z]` or `{x, y, z}`, orientations `[x, y, z, w]` or `{x, y, z, w}` (both forms occur).
-The scenario gets no workspace box and the loader's own time and cost defaults (docs/robots-and-data.md, 'MoveIt scenes').
+The scenario gets no workspace box and the loader's own time and cost defaults (docs/robots-and-data.md,
+'MoveIt scenes').
 """
 
 from __future__ import annotations

@@ -340,7 +340,8 @@ SCENARIO = Mapping(
     optional={"name": String(), "scene": Mapping(optional={"obstacles": Sequence(OBSTACLE), "workspace": WORKSPACE}),
               "time": TIME, "cost": COST},
 )
-"""A scenario file (docs/formats.md, 'Scenario files'); start and goal have the robot's n values (checked on loading)."""
+"""A scenario file (docs/formats.md, 'Scenario files'); start and goal have the robot's n values (checked on
+loading)."""
 
 SPEC = Mapping(
     required={

@@ -82,7 +82,7 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     _BUILDS[key] = Build(discretization, prepared, ended - began,
                          {"graph": built - began, "solver": ended - built - compiled, "compile": compiled},
                          max(_resident() - resident, SMALLEST_BUILD))
-    while len(_BUILDS) > 1 and sum(b.nbytes for b in _BUILDS.values()) > memory_budget():
+    while len(_BUILDS) > 1 and cached_bytes() > memory_budget():
         _BUILDS.popitem(last=False)
     return _BUILDS[key]
 

@@ -386,10 +386,10 @@ class SeedOptions:
     until the budget ends and PRM watches for a solution in a second thread, so their paths may depend on machine
     speed. `resolution` (rad): spacing of collision checks along straight joint-space segments. `grid_points`:
     TOPP-RA's path points. `margin` (m): clearance kept while planning, lowered to half the start's or goal's
-    clearance if that is smaller (`planning_space`). `max_checks`: OMPL stops after checking this many configurations too (a
-    budget that repeats on any machine; planning_time may then be inf; only for the planners that plan in the
-    calling thread, not PRM). `max_step` (rad): the longest extension of RRTConnect and RRT* (OMPL's `range`;
-    BIT* and PRM have none); None: OMPL's."""
+    clearance if that is smaller (`planning_space`). `max_checks`: OMPL stops after checking this many
+    configurations too (a budget that repeats on any machine; planning_time may then be inf; only for the
+    planners that plan in the calling thread, not PRM). `max_step` (rad): the longest extension of RRTConnect
+    and RRT* (OMPL's `range`; BIT* and PRM have none); None: OMPL's."""
 
     planner_name: str = "rrtconnect"
     planning_time: float = 1.0

@@ -4,10 +4,11 @@ An arm of many spheres among many obstacles has many collision terms per point (
 sphere-obstacle terms within reach), most of them far from contact on any motion the solver will consider;
 IPOPT's linear solves grow with every row. So the planner builds the NLP with the terms whose clearance is below
 SCREEN_DISTANCE somewhere along the straight line and along the initial guess (`Constraint.screened`), solves,
-and — verification always checks every term densely — keeps a verified plan as it is. An unverified plan whose motion comes within MISSING_DISTANCE of a term left out is solved again,
-warm-started, with the terms near it added (a rebuild, part of the computation time), at most MAX_REBUILDS times;
-such a motion also ends the refinement rounds at once (ocpkit.planner.refinement), since rounds on an NLP without
-those rows cannot fix it: they would spend the rung's iterations and end `violated`, the rows still missing.
+and — verification always checks every term densely — keeps a verified plan as it is. An unverified plan whose
+motion comes within MISSING_DISTANCE of a term left out is solved again, warm-started, with the terms near it
+added (a rebuild, part of the computation time), at most MAX_REBUILDS times; such a motion also ends the
+refinement rounds at once (ocpkit.planner.refinement), since rounds on an NLP without those rows cannot fix it:
+they would spend the rung's iterations and end `violated`, the rows still missing.
 Every robot and scene with collision terms screens, the paper's robot too: its paper cases keep few of them, and
 IPOPT's linear solves shrink with the rows.
 """

@@ -1,7 +1,8 @@
 """The simultaneous planner (the paper's method): path and timing together as one optimal control problem.
 
-A build of the problem's shape (ocpkit.planner.build_cache: transcription + dynamics + constraints + prepared solver, reused
-across queries), an initial guess, the solve with refinement rounds (ocpkit.planner.refinement), and `finish`.
+A build of the problem's shape (ocpkit.planner.build_cache: transcription + dynamics + constraints + prepared
+solver, reused across queries), an initial guess, the solve with refinement rounds (ocpkit.planner.refinement),
+and `finish`.
 """
 
 from __future__ import annotations

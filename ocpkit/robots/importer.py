@@ -28,11 +28,7 @@ from ocpkit.errors import RobotError
 from ocpkit.robots.robot import place_base, reduced_model
 from ocpkit.robots.self_collision import Pairs, self_collision_pairs
 from ocpkit.robots.spheres import Sphere, urdf_root
-from ocpkit.robots.urdf import (
-    EXAMPLE_ROBOT_DATA,
-    example_robot_data_dir,
-    model_from_urdf,
-)
+from ocpkit.robots.urdf import EXAMPLE_ROBOT_DATA, example_robot_data_dir, model_from_urdf
 
 TORQUE_RATE_PER_SECOND = 10.0
 """Torque-rate limit per N m of torque limit, 1/s, when the URDF gives none (it never does)."""

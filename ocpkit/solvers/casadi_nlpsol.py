@@ -30,16 +30,8 @@ import numpy as np
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP, Stages
-from ocpkit.solvers.base import (
-    BOUND_TOLERANCE,
-    STAGES_NEEDED,
-    PreparedSolver,
-    Solver,
-    SolverResult,
-    SolverStatus,
-    bound_slack,
-    time_limit,
-)
+from ocpkit.solvers.base import (BOUND_TOLERANCE, STAGES_NEEDED, PreparedSolver, Solver, SolverResult, SolverStatus,
+                                 bound_slack, time_limit)
 from ocpkit.solvers.pointwise import pointwise_derivatives
 
 _UNIFIED_STATUS = {
@@ -332,8 +324,8 @@ class Fatrop(CasadiNlpsol):
     mode), and fatrop's Riccati recursion runs stage by stage. An NLP without it (pseudospectral: the
     differentiation matrix couples every knot with every other) runs only when asked with `single_stage=True`:
     one stage (N = 0) whose "controls" are all of w and whose stage rows are all of g, one dense factorization per
-    iteration, far slower than IPOPT on the same NLP. It needs the exact Hessian: an NLP without one (a callback dynamics backend)
-    is refused with an OptionError. Extra keyword options go to fatrop verbatim."""
+    iteration, far slower than IPOPT on the same NLP. It needs the exact Hessian: an NLP without one (a callback
+    dynamics backend) is refused with an OptionError. Extra keyword options go to fatrop verbatim."""
 
     name = plugin = "fatrop"
     statuses = {"0": SolverStatus.CONVERGED}

@@ -5,7 +5,8 @@ that are one point function's value).
 CasADi differentiates a whole graph at once, sweeping all of it once per colour of the Jacobian's columns; a
 Chebyshev row reads every knot of a joint, so there are several colours per knot, and those sweeps make the
 set-up slow (figures: docs/design-notes.md). Here each distinct point function F(z) is differentiated once, on
-its own few inputs z, and the chain rule joins the calls (Z stacks every call's z; λ_k weighs call k: its rows' multipliers, or λ_f):
+its own few inputs z, and the chain rule joins the calls (Z stacks every call's z; λ_k weighs call k: its rows'
+multipliers, or λ_f):
 
     ∂g/∂x = blockdiag(∂F/∂z(z_k)) A,    A = ∂Z/∂x
     ∇²ₓ(λ_f f + λᵀg) = Aᵀ blockdiag(∇²_z(λ_kᵀF)(z_k)) A + Σᵢ vᵢ ∇²ₓZᵢ,    v = blockdiag(∂F/∂z(z_k))ᵀ λ

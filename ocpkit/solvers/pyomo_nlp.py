@@ -62,13 +62,7 @@ from pyomo.opt import SolverStatus as PyomoStatus
 
 from ocpkit.errors import OptionError
 from ocpkit.nlp import NLP
-from ocpkit.solvers.base import (
-    PreparedSolver,
-    Solver,
-    SolverResult,
-    SolverStatus,
-    time_limit,
-)
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus, time_limit
 from ocpkit.solvers.casadi_nlpsol import hessian_approximation
 
 _UNARY: dict[int, Callable] = {

@@ -22,13 +22,7 @@ import numpy as np
 import scipy.optimize as so
 
 from ocpkit.nlp import NLP
-from ocpkit.solvers.base import (
-    PreparedSolver,
-    Solver,
-    SolverResult,
-    SolverStatus,
-    time_limit,
-)
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus, time_limit
 from ocpkit.solvers.nlp_functions import NLPFunctions
 
 

@@ -65,13 +65,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ocpkit.nlp import NLP
-from ocpkit.solvers.base import (
-    PreparedSolver,
-    Solver,
-    SolverResult,
-    SolverStatus,
-    time_limit,
-)
+from ocpkit.solvers.base import PreparedSolver, Solver, SolverResult, SolverStatus, time_limit
 from ocpkit.solvers.nlp_functions import NLPFunctions
 
 ACCEPT, POOR, GOOD = 0.1, 0.25, 0.75

@@ -69,8 +69,9 @@ class MeshInterpolant:
         mid = None if self.mids is None else node(self.mids[k])
         v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, h, (at - k)[:, None])
         x = Node(v.q, v.qd, v.qdd, v.u)
-        return self.ocp.chain_samples(t, x, v.du_ds / h) if self.chain else self.ocp.samples(t, x, v.du_ds / h,
-                                                                                             v.dqdd_ds / h)
+        if self.chain:
+            return self.ocp.chain_samples(t, x, v.du_ds / h)
+        return self.ocp.samples(t, x, v.du_ds / h, v.dqdd_ds / h)
 
 
 class MeshDiscretization(Discretization):

@@ -89,7 +89,9 @@ class PseudospectralInterpolant:
         values, rates = L @ self.columns.T, Ld @ self.columns.T * (2.0 * self.grid.K / self.tf)
         m = self.ocp.chain
         x, du_dt = self.ocp.split(values), rates[:, 3 * m:]
-        return self.ocp.chain_samples(t, x, du_dt) if self.chain else self.ocp.samples(t, x, du_dt, rates[:, 2 * m:3 * m])
+        if self.chain:
+            return self.ocp.chain_samples(t, x, du_dt)
+        return self.ocp.samples(t, x, du_dt, rates[:, 2 * m:3 * m])
 
 
 def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:

@@ -11,15 +11,7 @@ import pinocchio as pin
 import viser
 
 from ocpkit.geometry.scene import Workspace
-from ocpkit.viewer.motion import (
-    OBSTACLE_COLOR,
-    ROBOT_COLOR,
-    WORKSPACE_COLOR,
-    Motion,
-    Shape,
-    box_edges,
-    scene_bounds,
-)
+from ocpkit.viewer.motion import OBSTACLE_COLOR, ROBOT_COLOR, WORKSPACE_COLOR, Motion, Shape, box_edges, scene_bounds
 
 OPACITY = 0.6
 

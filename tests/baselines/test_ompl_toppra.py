@@ -15,14 +15,7 @@ import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
 from ocpkit.baselines.ompl_toppra import plan_ompl_toppra
 from ocpkit.errors import OptionError, RegistryError, ScenarioError
 from ocpkit.geometry.clearances import clearances, sphere_centers
-from ocpkit.planner.ompl_seed import (
-    MAX_STEP,
-    FreeSpace,
-    _planner,
-    _space_information,
-    _state,
-    planning_space,
-)
+from ocpkit.planner.ompl_seed import MAX_STEP, FreeSpace, _planner, _space_information, _state, planning_space
 from ocpkit.tolerances import GEOMETRY_TOLERANCE
 
 

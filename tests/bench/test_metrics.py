@@ -6,12 +6,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from ocpkit.bench.metrics import (
-    end_effector_positions,
-    plan_metrics,
-    success_grid,
-    summarize,
-)
+from ocpkit.bench.metrics import end_effector_positions, plan_metrics, success_grid, summarize
 from ocpkit.formats.trajectory import Samples
 from ocpkit.robots import load_robot
 

@@ -9,18 +9,8 @@ import numpy as np
 import pytest
 from helpers import REPO
 
-from ocpkit.bench.perf import (
-    EVALUATIONS,
-    GROWTH_CASE,
-    PARTS,
-    cluttered,
-    cold_compile,
-    fitted_exponent,
-    ipopt_timing,
-    linear_share,
-    planned,
-    run_perf,
-)
+from ocpkit.bench.perf import (EVALUATIONS, GROWTH_CASE, PARTS, cluttered, cold_compile, fitted_exponent, ipopt_timing,
+                               linear_share, planned, run_perf)
 from ocpkit.formats.scenario import load_scenario
 from ocpkit.geometry.clearances import clearances, sphere_centers
 from ocpkit.solvers.compiled import compiler

@@ -9,15 +9,8 @@ import pytest
 from helpers import REPO
 
 import ocpkit
-from ocpkit.constraints import (
-    CONSTRAINTS,
-    DEFAULT_CONSTRAINTS,
-    Constraint,
-    Context,
-    PointValues,
-    Rows,
-    make_constraints,
-)
+from ocpkit.constraints import (CONSTRAINTS, DEFAULT_CONSTRAINTS, Constraint, Context, PointValues, Rows,
+                                make_constraints)
 from ocpkit.constraints.limits import StateLimits, TorqueLimit, TorqueRateLimit
 from ocpkit.dynamics import make_dynamics
 from ocpkit.errors import RegistryError

@@ -13,12 +13,7 @@ from helpers import REPO
 
 from ocpkit.cli.main import main
 from ocpkit.errors import MoveItError, RobotError
-from ocpkit.formats.moveit import (
-    convert_moveit,
-    read_moveit,
-    resolve_robot,
-    scenario_text,
-)
+from ocpkit.formats.moveit import convert_moveit, read_moveit, resolve_robot, scenario_text
 from ocpkit.formats.scenario import load_scenario, problem_from_dict
 from ocpkit.formats.schema import SCENARIO, check
 

@@ -11,12 +11,7 @@ import yaml
 
 import ocpkit
 import ocpkit.geometry.clearances
-from ocpkit.geometry.clearances import (
-    Clearances,
-    clearances,
-    collision_report,
-    sphere_centers,
-)
+from ocpkit.geometry.clearances import Clearances, clearances, collision_report, sphere_centers
 from ocpkit.geometry.scene import Scene, Workspace
 from ocpkit.robots.robot import DATA_DIR
 
@@ -145,4 +140,5 @@ def test_batched_sphere_centres_of_prismatic_joints_match_pinocchio():
     robot = dataclasses.replace(ROBOT, model=model, sphere_joint=np.array([a, b, c, c]),
                                  sphere_offset=RNG.normal(size=(4, 3)))
     qs = RNG.uniform(-1, 1, (20, 3))
-    np.testing.assert_allclose(ocpkit.geometry.clearances.sphere_centers_batch(robot, qs), sphere_centers(robot, qs), atol=1e-12)
+    np.testing.assert_allclose(ocpkit.geometry.clearances.sphere_centers_batch(robot, qs), sphere_centers(robot, qs),
+                               atol=1e-12)

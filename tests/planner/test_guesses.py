@@ -9,12 +9,7 @@ import pytest
 from helpers import REPO
 
 from ocpkit.formats.scenario import load_scenario
-from ocpkit.planner.guesses import (
-    PEAK_SPEED,
-    motion_time_estimate,
-    quintic,
-    torque_ratio,
-)
+from ocpkit.planner.guesses import PEAK_SPEED, motion_time_estimate, quintic, torque_ratio
 
 CASE2 = load_scenario(REPO / "scenarios/paper/case2.yaml")
 

@@ -19,18 +19,8 @@ from ocpkit.errors import NoGuess, OptionError
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
-from ocpkit.planner.ladder import (
-    DEFAULT_LADDER,
-    FINER_ITERATIONS,
-    NO_PATH_HINT,
-    OMPL_CHECKS,
-    SINGLE_SHOT,
-    Rung,
-    climb,
-    finer,
-    finer_grid,
-    rank,
-)
+from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, SINGLE_SHOT, Rung,
+                                   climb, finer, finer_grid, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow

@@ -11,17 +11,8 @@ from helpers import REPO
 import ocpkit
 from ocpkit.nlp import Refinement
 from ocpkit.planner.build_cache import build
-from ocpkit.planner.refinement import (
-    DEFAULT_ROUNDS,
-    LIMIT_BACKOFF,
-    MIN_MARGIN_STEP,
-    MIN_SHRINK,
-    PENETRATION_FACTOR,
-    RELAXED,
-    margin_step,
-    next_refinement,
-    solve_refined,
-)
+from ocpkit.planner.refinement import (DEFAULT_ROUNDS, LIMIT_BACKOFF, MIN_MARGIN_STEP, MIN_SHRINK, PENETRATION_FACTOR,
+                                       RELAXED, margin_step, next_refinement, solve_refined)
 from ocpkit.solvers import SolverResult, SolverStatus
 from ocpkit.verify import Check, Verification
 

@@ -13,11 +13,7 @@ from ocpkit.formats.scenario import load_scenario
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.screening import line_samples, worth_screening
-from ocpkit.planner.simultaneous import (
-    END_CHECK_CLEARANCE,
-    _checked_near_the_ends,
-    plan_simultaneous,
-)
+from ocpkit.planner.simultaneous import END_CHECK_CLEARANCE, _checked_near_the_ends, plan_simultaneous
 from ocpkit.transcription.pseudospectral import long_interval_midpoints
 from tests.helpers import REPO
 

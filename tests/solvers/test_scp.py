@@ -7,15 +7,7 @@ import casadi as ca
 import numpy as np
 import pytest
 from helpers import REPO
-from toy_nlps import (
-    BOUNDS,
-    GUESS,
-    PARAMS,
-    decision_vector,
-    optimum,
-    rosenbrock_disk,
-    toy_nlp,
-)
+from toy_nlps import BOUNDS, GUESS, PARAMS, decision_vector, optimum, rosenbrock_disk, toy_nlp
 
 import ocpkit
 from ocpkit.nlp import NLP

@@ -3,14 +3,8 @@
 import numpy as np
 import pytest
 
-from ocpkit.transcription.polynomials import (
-    barycentric_weights,
-    clenshaw_curtis_weights,
-    derivative_matrix,
-    differentiation_matrix,
-    interpolation_matrix,
-    lobatto_points,
-)
+from ocpkit.transcription.polynomials import (barycentric_weights, clenshaw_curtis_weights, derivative_matrix,
+                                              differentiation_matrix, interpolation_matrix, lobatto_points)
 
 RNG = np.random.default_rng(7)
 
