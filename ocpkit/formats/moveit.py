@@ -142,8 +142,9 @@ def scenario_text(conversion: Conversion, comments: Sequence[str] = ()) -> str:
 
 def _flow(value: Any) -> str:
     """One-line YAML of value (floats in full precision)."""
-    return yaml.safe_dump(value, default_flow_style=True, width=math.inf, sort_keys=False).strip().removesuffix(
-        "\n...").strip()
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml's emitter where PyYAML was built with it
+    return yaml.dump(value, Dumper=dumper, default_flow_style=True, width=2**31 - 1, sort_keys=False).strip(
+        ).removesuffix("\n...").strip()
 
 
 def _mapping(value: Any, where: str) -> dict:
