@@ -6,11 +6,14 @@ included), each constraint's shape, the solver and its options: start, goal, tim
 positions are numbers, so queries that differ only in them share a build. The cache holds the most recently used
 builds within a memory budget (`memory_budget`): each build's size is estimated as the growth of the process's
 resident memory while it was made, and the least recently used builds are dropped while the estimates add up to
-more than the budget (the newest always stays).
+more than the budget or the process's resident memory exceeds it (the newest always stays); dropped builds' memory
+is handed back to the operating system.
 """
 
 from __future__ import annotations
 
+import ctypes
+import gc
 import inspect
 import os
 import time
@@ -34,7 +37,7 @@ from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
 
 MEMORY_BUDGET = 2 * 1024**3
-"""Bytes the cached builds of one process may hold by default ($OCPKIT_BUILD_MEMORY_MB overrides)."""
+"""Bytes of resident memory a process keeps cached builds within by default ($OCPKIT_BUILD_MEMORY_MB overrides)."""
 SMALLEST_BUILD = 1024**2
 """Bytes a build is counted as at least (memory freed by an evicted build can be reused by the next one)."""
 
@@ -82,9 +85,16 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     _BUILDS[key] = Build(discretization, prepared, ended - began,
                          {"graph": built - began, "solver": ended - built - compiled, "compile": compiled},
                          max(_resident() - resident, SMALLEST_BUILD))
-    while len(_BUILDS) > 1 and cached_bytes() > memory_budget():
-        _BUILDS.popitem(last=False)
+    _evict(memory_budget())
     return _BUILDS[key]
+
+
+def _evict(budget: int) -> None:
+    """Drop the least recently used builds (the newest stays) while their estimates add up to more than `budget`
+    or the process's resident memory exceeds it, handing the freed memory back to the operating system."""
+    while len(_BUILDS) > 1 and (cached_bytes() > budget or _resident() > budget):
+        _BUILDS.popitem(last=False)
+        _release()
 
 
 def memory_budget() -> int:
@@ -122,8 +132,28 @@ def _staged_for(solver: str, solver_options: dict, transcription: str, transcrip
 
 
 def clear_builds() -> None:
-    """Forget every cached build."""
+    """Forget every cached build and hand the memory back to the operating system."""
     _BUILDS.clear()
+    _release()
+
+
+def _release() -> None:
+    """Free dropped builds now (CasADi graphs can sit in reference cycles) and return the allocator's free pages
+    to the operating system (glibc's malloc_trim; elsewhere only the collection)."""
+    gc.collect()
+    if _LIBC is not None:
+        _LIBC.malloc_trim(0)
+
+
+def _glibc() -> ctypes.CDLL | None:
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        return libc if hasattr(libc, "malloc_trim") else None
+    except OSError:  # not glibc (macOS, Windows, musl)
+        return None
+
+
+_LIBC = _glibc()
 
 
 def frozen(value: Any) -> Any:

@@ -109,6 +109,7 @@ def test_an_unchanged_copy_of_the_robot_files_shares_the_build(tmp_path):
 def test_the_cache_keeps_the_most_recently_used_builds_within_its_memory_budget(monkeypatch):
     clear_builds()
     monkeypatch.setattr(build_cache, "SMALLEST_BUILD", 400 * 1024**2)  # every build counts as 400 MiB
+    monkeypatch.setattr(build_cache, "_resident", lambda: 0)  # and the process itself holds nothing
     monkeypatch.setenv("OCPKIT_BUILD_MEMORY_MB", "900")  # room for two
     a = ocpkit.build(PROBLEM, knots=6).discretization
     b = ocpkit.build(PROBLEM, knots=7).discretization
@@ -117,6 +118,20 @@ def test_the_cache_keeps_the_most_recently_used_builds_within_its_memory_budget(
     assert ocpkit.build(PROBLEM, knots=6).discretization is a
     rebuilt = ocpkit.build(PROBLEM, knots=7)
     assert rebuilt.discretization is not b and rebuilt.setup_time > 0
+
+
+def test_a_process_past_its_budget_keeps_only_the_newest_build_and_returns_the_memory(monkeypatch):
+    clear_builds()
+    monkeypatch.setenv("OCPKIT_BUILD_MEMORY_MB", "900")
+    released = []
+    monkeypatch.setattr(build_cache, "_release", lambda: released.append(True))
+    a = ocpkit.build(PROBLEM, knots=6).discretization
+    b = ocpkit.build(PROBLEM, knots=7).discretization  # both estimates are far below 900 MiB
+    assert ocpkit.build(PROBLEM, knots=6).discretization is a and not released
+    monkeypatch.setattr(build_cache, "_resident", lambda: 901 * 1024**2)  # the process grew past the budget
+    ocpkit.build(PROBLEM, knots=8)
+    assert len(released) == 2 and len(build_cache._BUILDS) == 1  # a and b dropped, each freed at once
+    assert ocpkit.build(PROBLEM, knots=7).discretization is not b
 
 
 def test_clear_builds_forgets_everything():
