@@ -18,6 +18,14 @@ on the fixed base never move at all; they are checked once, when the problem is 
 margin is an NLP parameter (a refinement round may raise it), so terms are kept up to MAX_MARGIN.
 `screened` goes further for robots with many terms: it keeps only the terms near given configurations (the
 planner's active set, ocpkit.planner.screening); the pairs and terms kept are then part of the shape too.
+
+Grouped rows. An arm with a spherized model (MotionBenchMaker's Panda and UR5: 700–1 100 terms per point,
+against the paper robot's 60–90) would put thousands of rows into IPOPT's KKT system. Beyond GROUP_ABOVE terms per
+point (counted before screening), the terms of one group — one joint's spheres against one obstacle, or the sphere
+pairs between two joints — become one row, their soft minimum (`soft_minimum`): smooth, never above the smallest
+term, so a grouped row ≥ 0 still keeps every sphere clear (conservative by at most log(terms) / SOFTMIN_SHARPNESS
+m², under 2 mm of distance at the spheres' sizes), and `verify` checks every sphere as before. Each term keeps its
+own margin and cap inside its group.
 """
 
 from __future__ import annotations
@@ -33,6 +41,8 @@ from ocpkit.problem import Problem
 from ocpkit.robots import sphere_reach
 
 MAX_MARGIN = 0.1  # m: the largest clearance margin the kept collision terms stay valid for
+GROUP_ABOVE = 200  # collision terms per point above which they are grouped into one row per group (docstring)
+SOFTMIN_SHARPNESS = 2e4  # 1/m²: β of a group's soft minimum; it lies at most log(terms) / β below the minimum
 RADIAL_EPS = 1e-12  # m²: under the cylinder's radial root (shifts it by < 1e-9 m where it counts, radii ≥ 1 mm)
 
 
@@ -68,6 +78,7 @@ class SphereCollision(Constraint):
         self.counts = (len(scene.obstacle_radii), len(scene.boxes), len(scene.cylinders))
         pairs = self.robot.self_collision
         self.pair_mask = (self.robot.sphere_joint[pairs] > 0).any(axis=1) if len(pairs) else np.zeros(0, bool)
+        self.grouped = self.term_count > GROUP_ABOVE
 
     @property
     def pairs(self) -> np.ndarray:
@@ -96,7 +107,7 @@ class SphereCollision(Constraint):
 
     def shape(self) -> tuple:
         return (self.counts, self.obstacle_mask.shape, self.obstacle_mask.tobytes(), self.face_mask.shape,
-                self.face_mask.tobytes(), self.pair_mask.tobytes())
+                self.face_mask.tobytes(), self.pair_mask.tobytes(), self.grouped)
 
     def screened(self, problem: Problem, near: np.ndarray, distance: float) -> SphereCollision:
         """A copy keeping the terms whose clearance (m) is below `distance` at some configuration of `near`."""
@@ -129,7 +140,7 @@ class SphereCollision(Constraint):
                 "cylinder_center": (cylinders, 3), "cylinder_half_size": (cylinders, 2),  # [radius, length / 2]
                 "cylinder_rotation": (cylinders, 9),  # rotations row-major
                 "workspace": (self.face_mask.shape[1], 1),  # [lower (3), upper (3)] or nothing
-                "margin_cap": (self.term_count, 1)}  # per row
+                "margin_cap": (self.term_count, 1)}  # per term
 
     def parameter_values(self, problem: Problem) -> dict[str, np.ndarray]:
         scene = problem.scene
@@ -144,14 +155,17 @@ class SphereCollision(Constraint):
                 "workspace": np.concatenate([np.zeros(0), *box]), "margin_cap": self.margin_caps(problem)}
 
     def evaluate(self, point: PointValues, context: Context) -> Rows:
-        """Rows ≥ 0 (workspace rows of two faces ≤ 1), each with the margin min(margin, its cap) (`margin_caps`)."""
+        """Rows ≥ 0 (workspace rows of two faces ≤ 1), each term with the margin min(margin, its cap)
+        (`margin_caps`); with `grouped`, one row per group of terms (module docstring)."""
         radius, p = self.robot.sphere_radius, context.parameters
         margins = iter(ca.fmin(context.margin, p["margin_cap"][k]) for k in range(self.term_count))
         centers = context.dynamics.sphere_centers(point.q)
-        g = []
+        joint = self.robot.sphere_joint
+        g, groups = [], []  # the terms in `margin_caps`' order, and the group of each
         for a, b in self.pairs:
             gap = centers[a, :] - centers[b, :]
             g.append(ca.dot(gap, gap) - (radius[a] + radius[b] + next(margins)) ** 2)
+            groups.append(("self", joint[a], joint[b]))
         spheres, boxes, _ = self.counts
         for m, s in zip(*np.nonzero(self.obstacle_mask)):
             if s < spheres:
@@ -162,6 +176,12 @@ class SphereCollision(Constraint):
                 local = _local(centers[m, :], p[f"{kind}_center"][k, :], p[f"{kind}_rotation"][k, :])
                 outside = _outside_squared(local, p[f"{kind}_half_size"][k, :], kind == "cylinder")
                 g.append(outside - (radius[m] + next(margins)) ** 2)
+            groups.append(("obstacle", joint[m], s))
+        if self.grouped:
+            members: dict[tuple, list[ca.SX]] = {}
+            for group, term in zip(groups, g):
+                members.setdefault(group, []).append(term)
+            g = [soft_minimum(terms) for terms in members.values()]
         upper = [np.inf] * len(g)
         box = p["workspace"]
         for m, axis in zip(*self._face_rows()):
@@ -169,6 +189,16 @@ class SphereCollision(Constraint):
             upper.append(1.0 if self.face_mask[m, axis] and self.face_mask[m, axis + 3] else np.inf)
         g = ca.vertcat(*g) if g else ca.SX(0, 1)
         return Rows(g, np.zeros(g.numel()), np.asarray(upper, dtype=float))
+
+
+def soft_minimum(terms: list[ca.SX]) -> ca.SX:
+    """A smooth lower bound of min(terms) (m²), within log(len(terms)) / SOFTMIN_SHARPNESS of it:
+    m − log Σ exp(−β (t − m)) / β with m = min(terms), exact for one term."""
+    if len(terms) == 1:
+        return terms[0]
+    values = ca.vertcat(*terms)
+    low = ca.mmin(values)
+    return low - ca.log(ca.sum1(ca.exp(-SOFTMIN_SHARPNESS * (values - low)))) / SOFTMIN_SHARPNESS
 
 
 def _local(c: ca.SX, center: ca.SX, rotation: ca.SX) -> ca.SX:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 
 import casadi as ca
@@ -11,7 +12,7 @@ from helpers import REPO
 
 import ocpkit
 from ocpkit.constraints import Context, PointValues
-from ocpkit.constraints.collision import MAX_MARGIN, SphereCollision, active_terms
+from ocpkit.constraints.collision import MAX_MARGIN, SOFTMIN_SHARPNESS, SphereCollision, active_terms
 from ocpkit.dynamics import make_dynamics
 from ocpkit.geometry.clearances import clearances, sphere_centers
 from ocpkit.geometry.distance import box_distance, cylinder_distance
@@ -31,11 +32,13 @@ def with_scene(**changes) -> ocpkit.Problem:
 def evaluate(constraint: SphereCollision, problem: ocpkit.Problem, q: np.ndarray, margin: float
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(g, lower, upper) at configuration q with the problem's own parameter values, via a ca.Function."""
-    point = PointValues(*(ca.SX.sym(k, N) for k in ("q", "qd", "qdd", "tau", "dtau_ds")), ca.SX.sym("dt_ds"))
+    n = problem.robot.n
+    point = PointValues(*(ca.SX.sym(k, n) for k in ("q", "qd", "qdd", "tau", "dtau_ds")), ca.SX.sym("dt_ds"))
     shapes = constraint.parameter_shapes()
     symbols = {name: ca.SX.sym(name, *shape) for name, shape in shapes.items()}
     margin_sx = ca.SX.sym("margin")
-    rows = constraint.evaluate(point, Context(make_dynamics("casadi", ROBOT), margin_sx, ca.SX.sym("s"), symbols))
+    rows = constraint.evaluate(point, Context(make_dynamics("casadi", problem.robot), margin_sx, ca.SX.sym("s"),
+                                              symbols))
     function = ca.Function("rows", [point.q, margin_sx, *symbols.values()], [rows.g])
     values = constraint.parameter_values(problem)
     g = function(q, margin, *(np.reshape(values[name], shapes[name]) for name in symbols))
@@ -240,3 +243,27 @@ def test_empty_scene_without_self_pairs_gives_an_empty_column():
     constraint.pair_mask[:] = False
     g, lower, upper = evaluate(constraint, problem, PROBLEM.start, margin=0.0)
     assert g.shape == lower.shape == upper.shape == (0,)
+
+
+def test_a_spherized_arm_gets_one_row_per_group_never_above_its_smallest_term():
+    """MBM's Panda: one row per (joint, obstacle) and per joint pair, each within log(terms) / β below the smallest
+    of its terms; the paper robot keeps a row per term."""
+    problem = ocpkit.load_scenario(REPO / "scenarios/mbm/panda/box/0001.yaml")
+    grouped = SphereCollision(problem)
+    assert grouped.grouped and not SphereCollision(PROBLEM).grouped
+    each = copy.copy(grouped)
+    each.grouped = False
+    joint = problem.robot.sphere_joint
+    keys = [("self", joint[a], joint[b]) for a, b in grouped.pairs]
+    keys += [("obstacle", joint[m], s) for m, s in zip(*np.nonzero(grouped.obstacle_mask))]
+    groups = list(dict.fromkeys(keys))
+    robot = problem.robot
+    for q in np.random.default_rng(8).uniform(robot.q_lower, robot.q_upper, (3, robot.n)):
+        rows = evaluate(grouped, problem, q, 0.01)[0]
+        terms = evaluate(each, problem, q, 0.01)[0]
+        smallest = np.array([min(t for k, t in zip(keys, terms) if k == g) for g in groups])
+        count = np.array([keys.count(g) for g in groups])
+        assert np.all(rows[:len(groups)] <= smallest + 1e-12)
+        assert np.all(rows[:len(groups)] >= smallest - np.log(count) / SOFTMIN_SHARPNESS - 1e-12)
+        np.testing.assert_array_equal(rows[len(groups):], terms[len(keys):])  # workspace rows as they were
+    assert len(groups) < len(keys) / 5
