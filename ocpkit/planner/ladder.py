@@ -49,7 +49,7 @@ if TYPE_CHECKING:
     from ocpkit.planner.options import SimultaneousOptions
 
 MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
-MAX_WALL_TIME = 90.0  # s of computation for the whole ladder, the simultaneous planner's default (docstring)
+MAX_WALL_TIME = 90.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 
@@ -147,15 +147,15 @@ def rank(plan: Plan) -> tuple[int, float]:
 def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:
     """Plan with `attempt(rung, seconds left)` on each rung of `ladder` in turn, each followed by its `finer` rung
     when its plan calls for one (on None once if the ladder is empty), until one verifies or the `max_wall_time` (s)
-    of computation is spent; the first verified plan, else the best by `rank`, with the stats of all attempts
-    (module docstring)."""
+    of computation and set-up is spent; the first verified plan, else the best by `rank`, with the stats of all
+    attempts (module docstring)."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
     skipped: list[str] = []
 
     def left() -> float:
-        return max_wall_time - sum(p.stats.solve_time for _, p in tried)
+        return max_wall_time - sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
 
     for rung in ladder:
         if tried and left() <= 0:

@@ -72,14 +72,15 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
 
 def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: float) -> Plan:
     """One plan with `options`: build, guess, solve with refinement rounds, all within `max_wall_time` (s) of
-    computation. A guess rule with no start to offer (NoGuess) ends the plan as `no_path` before any solve. With
-    screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight line; a guess or
-    an unverified solution that comes near rows left out is solved again on a rebuild with them added."""
+    computation and set-up. A guess rule with no start to offer (NoGuess) ends the plan as `no_path` before any
+    solve. With screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight
+    line; a guess or an unverified solution that comes near rows left out is solved again on a rebuild with them
+    added."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
     options = _checked_near_the_ends(problem, options)
+    deadline = started + max_wall_time  # the set-up counts against the budget too
     made = _build(problem, options, near)
-    deadline = time.perf_counter() + max_wall_time
     dynamics = options.dynamics
     method = {"planner": "simultaneous", "transcription": options.transcription, "knots": options.knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options.solver}

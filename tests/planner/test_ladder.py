@@ -32,7 +32,7 @@ CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
 def fake(status: str, worst: float = 0.0, seconds: float = 1.0, iterations: int = 10, check: str = "obstacle",
          trajectory: object = None) -> Plan:
     """A plan with `status`, one `check` of `worst` (failed if > 0; at t = 0.5 s a path violation a refinement
-    round can fix unless the check is "dynamics"), `seconds` of computation."""
+    round can fix unless the check is "dynamics"), `seconds` of computation and 0.5 s of set-up."""
     times = np.array([0.5]) if worst > 0 and check != "dynamics" else np.zeros(0)
     verification = Verification((Check(check, worst, 0.0, 0.5, "m"),), times)
     stats = PlanStats(seconds, 0.5, iterations, 1, f"{status} message", extra={"own": 1})
@@ -92,7 +92,7 @@ def test_every_rung_gets_the_time_left_and_none_starts_after_the_budget():
     script = Script({"a": fake("infeasible", seconds=5.0), "b": fake("iteration_limit", seconds=4.0),
                      "c": fake("verified")})
     result = climb(script, LADDER, 8.0)
-    assert script.calls == [("a", 8.0), ("b", 3.0)]
+    assert script.calls == [("a", 8.0), ("b", 2.5)]  # a's 5 s of computation and 0.5 s of set-up spent
     assert result.status == "infeasible" and result.method["rung"] == "a"
 
 
@@ -266,7 +266,7 @@ def test_a_plan_violated_only_by_the_dynamics_residual_is_re_solved_on_a_finer_g
     script = Recording({"a": fake("violated", 0.02, seconds=5.0, check="dynamics", trajectory=motion),
                         "a-finer": fake("verified", seconds=2.0), "b": fake("verified")})
     result = climb(script, LADDER, 20.0)
-    assert script.calls == [("a", 20.0), ("a-finer", 15.0)]
+    assert script.calls == [("a", 20.0), ("a-finer", 14.5)]
     assert script.rungs[1].refines is motion and script.rungs[1].knots == LADDER[0].knots
     assert result.ok and result.method["rung"] == "a-finer"
 
