@@ -61,11 +61,12 @@ def run_suite(suite_file: str | Path, out: str | Path, jobs: int = 1, scheduler:
 
 
 def summary_lines(rows: list[dict]) -> list[str]:
-    """One line per method: runs, success and the verified plans' median and 98th-percentile computation time and
-    median t_f."""
+    """One line per method: runs, success, the verified plans' median and 98th-percentile computation time and
+    median t_f, and every plan's median wait (computation and set-up, failures included)."""
     return [f"{s['method']}: {s['runs']} runs, {formatted(s['success_%'])} % verified, computation median "
             f"{formatted(s['time_median_s'])} s, p98 {formatted(s['time_p98_s'])} s, "
-            f"t_f median {formatted(s['tf_s'])} s" for s in summarize(rows, ("method",))]
+            f"t_f median {formatted(s['tf_s'])} s; with set-up, every plan: median {formatted(s['all_median_s'])} s, "
+            f"p90 {formatted(s['all_p90_s'])} s" for s in summarize(rows, ("method",))]
 
 
 def _check_earlier(path: Path, suite: str) -> None:

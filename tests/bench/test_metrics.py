@@ -58,9 +58,10 @@ def test_the_panda_and_ur5_end_effectors_are_their_tool_points_at_the_zero_pose(
     assert end_effector_positions(ur5, np.zeros((1, 6)))[0] == pytest.approx(world, abs=1e-4)
 
 
-def row(method: str, scene: str, status: str, time: float, tf: float = 1.0) -> dict:
+def row(method: str, scene: str, status: str, time: float, tf: float = 1.0, setup: float = 0.5) -> dict:
     metrics = {"path_length_rad": "1", "ee_path_length_m": "2", "peak_torque_use": "0.5", "peak_torque_rate_use": "0.9"}
-    return {"method": method, "scene": scene, "status": status, "solve_time_s": str(time), "tf": str(tf), **metrics}
+    return {"method": method, "scene": scene, "status": status, "solve_time_s": str(time), "tf": str(tf),
+            "setup_time_s": str(setup), **metrics}
 
 
 def test_summary_times_are_over_the_verified_runs_and_success_is_a_rate():
@@ -73,6 +74,10 @@ def test_summary_times_are_over_the_verified_runs_and_success_is_a_rate():
     assert a["time_p75_s"] == pytest.approx(np.percentile(times, 75))
     assert a["time_p98_s"] == pytest.approx(np.percentile(times, 98))
     assert b["success_%"] == 0 and np.isnan(b["time_median_s"])
+    assert a["setup_median_s"] == 0.5 and b["all_median_s"] == 1.5  # a failure's wait counts in all_*
+    waited = [t + 0.5 for t in times + [9.0]]
+    assert a["all_median_s"] == pytest.approx(np.median(waited)) and a["all_p90_s"] == pytest.approx(
+        np.percentile(waited, 90))
     assert [(r["method"], r["scene"], r["runs"]) for r in summarize(rows, ("method", "scene"))] == [
         ("a", "s1", 5), ("a", "s2", 1), ("b", "s1", 1)]
     methods, scenes, rates = success_grid(rows)
