@@ -147,8 +147,8 @@ def rank(plan: Plan) -> tuple[int, float]:
 def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:
     """Plan with `attempt(rung, seconds left)` on each rung of `ladder` in turn, each followed by its `finer` rung
     when its plan calls for one (on None once if the ladder is empty), until one verifies or the `max_wall_time` (s)
-    of computation and set-up is spent; the first verified plan, else the best by `rank`, with the stats of all
-    attempts (module docstring)."""
+    of computation and set-up is spent (no rung starts with less time left than the last rung's set-up took); the
+    first verified plan, else the best by `rank`, with the stats of all attempts (module docstring)."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
@@ -157,14 +157,17 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     def left() -> float:
         return max_wall_time - sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
 
+    def room() -> bool:  # time for at least a build as long as the last one: a rung that cannot build only overruns
+        return not tried or left() > tried[-1][1].stats.setup_time
+
     for rung in ladder:
-        if tried and left() <= 0:
+        if not room():
             break
         if _repeats(rung, tried):
             skipped.append(rung.name)
             continue
         tried.append((rung, attempt(rung, max(left(), 0.0))))
-        if (next_rung := finer(*tried[-1])) is not None and left() > 0:
+        if (next_rung := finer(*tried[-1])) is not None and room():
             tried.append((next_rung, attempt(next_rung, left())))
         if tried[-1][1].ok:
             break

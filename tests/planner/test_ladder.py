@@ -96,6 +96,14 @@ def test_every_rung_gets_the_time_left_and_none_starts_after_the_budget():
     assert result.status == "infeasible" and result.method["rung"] == "a"
 
 
+def test_no_rung_starts_with_less_time_left_than_the_last_build_took():
+    slow_build = dataclasses.replace(fake("infeasible", seconds=5.0), stats=dataclasses.replace(
+        fake("infeasible").stats, solve_time=5.0, setup_time=3.5))
+    script = Script({"a": slow_build, "b": fake("verified")})
+    result = climb(script, LADDER, 10.0)  # 1.5 s left after a: less than a's 3.5 s build
+    assert script.calls == [("a", 10.0)] and result.method["rung"] == "a"
+
+
 def test_an_empty_ladder_is_one_attempt_with_the_calls_options():
     plan = fake("violated", 0.1)
     script = Script({"none": plan})
