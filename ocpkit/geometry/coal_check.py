@@ -39,19 +39,22 @@ class CoalCheck:
             for request in data.collisionRequests:
                 request.security_margin = margin
                 request.enable_contact = False
-        self.pairs = len(model.collisionPairs)
 
     def free(self, q: np.ndarray) -> np.ndarray:
         """Whether each configuration of q (K, n) keeps the margin everywhere: shape (K,), bool."""
-        q = np.asfortranarray(np.atleast_2d(q).T)
-        return ~np.asarray(pin.computeCollisionsInParallel(1, self.pool, q, True, False), dtype=bool)
+        return ~self._collides(q, stop_at_first=False)
 
     def first_collision(self, q: np.ndarray) -> int | None:
         """The index of the first configuration of q (K, n) that does not keep the margin, None if all do; the
         ones after it are not checked."""
-        q = np.asfortranarray(np.atleast_2d(q).T)
-        hits = np.flatnonzero(pin.computeCollisionsInParallel(1, self.pool, q, True, True))
+        hits = np.flatnonzero(self._collides(q, stop_at_first=True))
         return int(hits[0]) if len(hits) else None
+
+    def _collides(self, q: np.ndarray, stop_at_first: bool) -> np.ndarray:
+        """Per configuration of q (K, n), whether some pair is within the margin (bool (K,)); with `stop_at_first`
+        the configurations after the first such one are left False."""
+        columns = np.asfortranarray(np.atleast_2d(q).T)  # pinocchio takes configurations as columns
+        return np.asarray(pin.computeCollisionsInParallel(1, self.pool, columns, True, stop_at_first), dtype=bool)
 
 
 def _world_shapes(scene: Scene) -> list[tuple[str, pin.SE3, coal.CollisionGeometry]]:

@@ -108,7 +108,7 @@ class FreeSpace:
         if hit is None:
             self.checks += count
         else:
-            batches = int(np.log2(hit // SEGMENT_BATCH + 1)) + 1  # the batch [16 (2^j − 1), 16 (2^(j+1) − 1)) holds hit
+            batches = (hit // SEGMENT_BATCH + 1).bit_length()  # batch j covers [16 (2^j − 1), 16 (2^(j+1) − 1))
             self.checks += min(SEGMENT_BATCH * (2**batches - 1), count)
         return hit is None
 

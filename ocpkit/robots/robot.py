@@ -90,25 +90,23 @@ def load_robot(robot: str | dict[str, Any], base_dir: Path | None = None) -> Rob
 def robot_from_spec(spec_file: Path) -> Robot:
     """Build a Robot from a spec.yaml whose `urdf:` names its URDF (ocpkit.robots.urdf.resolve_urdf)."""
     spec_file = Path(spec_file)
-    text = _read(spec_file)
-    key = (spec_file.resolve(), hashlib.sha256(text).hexdigest())
-    if key not in _URDF_OF_SPEC:  # a spherized spec is long to parse: once per content, not per scenario
-        with within(spec_file):
-            spec = read_yaml(text, RobotError)
-            check(spec, SPEC, RobotError)
-            if "urdf" not in spec:
-                raise RobotError("missing 'urdf' (the spec names no URDF; give the robot as {urdf: path, spec: path})")
-        if len(_URDF_OF_SPEC) >= CACHE_SIZE:
-            _URDF_OF_SPEC.pop(next(iter(_URDF_OF_SPEC)))
-        _URDF_OF_SPEC[key] = spec["urdf"]
-    return robot_from_files(resolve_urdf(_URDF_OF_SPEC[key], spec_file.parent), spec_file)
+    return robot_from_files(resolve_urdf(_urdf_entry(spec_file, _read(spec_file)), spec_file.parent), spec_file)
+
+
+@functools.lru_cache(maxsize=16)  # a spherized spec is long to parse: once per content, not once per scenario
+def _urdf_entry(spec_file: Path, text: bytes) -> str:
+    """The `urdf:` entry of a spec file's text, schema-checked (RobotError naming the file otherwise)."""
+    with within(spec_file):
+        spec = read_yaml(text, RobotError)
+        check(spec, SPEC, RobotError)
+        if "urdf" not in spec:
+            raise RobotError("missing 'urdf' (the spec names no URDF; give the robot as {urdf: path, spec: path})")
+    return spec["urdf"]
 
 
 CACHE_SIZE = 16
 """How many Robots `robot_from_files` keeps by content key."""
 _BY_KEY: dict[str, Robot] = {}
-_URDF_OF_SPEC: dict[tuple[Path, str], str] = {}
-"""The `urdf:` entry of each spec file read, by (resolved path, sha256 of its bytes)."""
 
 
 def robot_from_files(urdf: Path, spec_file: Path) -> Robot:
