@@ -246,8 +246,13 @@ class Ipopt(CasadiNlpsol):
 
     def plugin_options(self, nlp: NLP) -> dict:
         derivatives = pointwise_derivatives(nlp, self.compiled) if nlp.point_calls and nlp.exact_hessian else {}
-        return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}, **derivatives}
+        return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}, **derivatives,
+                **NO_PARAMETER_MULTIPLIERS}
 
+
+NO_PARAMETER_MULTIPLIERS = {"no_nlp_grad": True, "calc_lam_p": False}
+"""nlpsol options: no multipliers of the parameters p (nothing reads them), so nlpsol does not build the reverse
+derivative of the whole NLP (`nlp_grad`), most of its construction on a large NLP (figures: docs/design-notes.md)."""
 
 _QPSOL_QUIET = {"qpoases": {"printLevel": "none"}, "osqp": {"osqp": {"verbose": False}}}
 """Per QP solver: options that silence it (all also get error_on_fail False: a failed QP ends the SQP)."""

@@ -16,12 +16,15 @@ shared by several calls (the values at one point) are differentiated once. The o
 interpolation defects, nearly linear) are differentiated by CasADi a few rows at a time, and the objective too
 when it is not a point call. The result equals CasADi's own derivatives (tests/solvers/test_pointwise.py).
 
-Calls marked `compiled` (the dynamics rows: their point function depends on the robot and the OCP only, so its C
-is the same for every problem of a robot) are differentiated by point functions compiled to C
-(ocpkit.solvers.compiled), evaluated over all their points by one mapped call, and joined by constant sparse
-matrices: blocks B_k placed as Σ_k L_kᵀ B_k R_k (L_k, R_k: row selections or A_k), whose nonzeros are P times
-the blocks' stacked nonzeros, vec(Lᵀ B R) = (Rᵀ ⊗ Lᵀ) vec(B). This needs A_k constant (inputs linear in x), and
-falls back to the SX graph where it is not or where nothing compiles.
+Calls whose inputs are linear in x (A_k constant: every robot OCP's point calls) are not inlined: each distinct
+point function's derivatives are built once, evaluated over all its points by one mapped call, and joined by
+constant sparse matrices, blocks B_k placed as Σ_k L_kᵀ B_k R_k (L_k, R_k: row selections or A_k), whose
+nonzeros are P times the blocks' stacked nonzeros, P's entries L_k[i, r] R_k[j, c] per nonzero (i, j) of B_k.
+Inlining them cost most of the set-up on a large NLP (a copy of a point Hessian per point), the mapped call
+evaluates as fast. Calls marked `compiled` (the dynamics rows: their point function depends on the robot and the
+OCP only, so its C is the same for every problem of a robot) run their point derivatives compiled to C
+(ocpkit.solvers.compiled), CasADi's virtual machine where nothing compiles. Calls with inputs not linear in x
+(a torque with friction, a path-timing OCP's state) take the SX graph.
 """
 
 from __future__ import annotations
@@ -43,12 +46,22 @@ def pointwise_derivatives(nlp: NLP, compile: bool = True) -> dict[str, ca.Functi
     """IPOPT's {"jac_g": (x, p) → (g, ∂g/∂x), "hess_lag": (x, p, λ_f, λ_g) → upper triangle of
     ∇²ₓ(λ_f f + λ_gᵀ g)} for `nlp` (SX, with point calls), built as the module docstring says; `compile`: the
     calls marked `compiled` through compiled point functions."""
-    marked = [c for c in nlp.point_calls if c.compiled] if compile else []
-    terms = _compiled_terms(nlp, marked) if marked else None
-    if terms is None:
-        return _graph_derivatives(nlp, list(nlp.point_calls), np.zeros(0, dtype=int))
-    kept = [c for c in nlp.point_calls if not c.compiled]
-    return _joined(nlp, _graph_derivatives(nlp, kept, np.concatenate([_rows(c) for c in marked])), terms)
+    maps = [_input_map(call, nlp) for call in nlp.point_calls]
+    mapped = [(call, a) for call, a in zip(nlp.point_calls, maps) if a is not None]
+    kept = [call for call, a in zip(nlp.point_calls, maps) if a is None]
+    if not mapped:
+        return _graph_derivatives(nlp, kept, np.zeros(0, dtype=int))
+    left = np.concatenate([_rows(call) for call, _ in mapped])
+    return _joined(nlp, _graph_derivatives(nlp, kept, left), _mapped_terms(nlp, mapped, compile))
+
+
+def _input_map(call: PointCall, nlp: NLP) -> sps.csr_matrix | None:
+    """A = ∂z/∂x of `call`'s inputs z as a constant sparse matrix (rows of z × n_w), or None when z is not linear
+    in x (A depends on x or p)."""
+    a = ca.jacobian(ca.vertcat(*(ca.vec(v) for v in call.inputs)), nlp.x)
+    if ca.depends_on(a, ca.vertcat(nlp.x, nlp.p)):
+        return None
+    return sps.csr_matrix(ca.evalf(a).sparse())
 
 
 def _rows(call: PointCall) -> np.ndarray:
@@ -95,38 +108,40 @@ def _joined(nlp: NLP, graphs: dict[str, ca.Function],
                                     ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])}
 
 
-def _compiled_terms(nlp: NLP, marked: list[PointCall]) -> tuple[ca.Function, ca.Function] | None:
-    """MX Functions (x, p → the `marked` calls' rows of ∂g/∂x; x, p, λ_g → their part of the Hessian's upper
-    triangle) through compiled point derivatives (module docstring); None when an input of theirs is not linear
-    in x or nothing compiles."""
+def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, sps.csr_matrix]],
+                  compile: bool) -> tuple[ca.Function, ca.Function]:
+    """MX Functions (x, p → the `mapped` calls' rows of ∂g/∂x; x, p, λ_g → their part of the Hessian's upper
+    triangle) for calls with constant input maps A (module docstring): one point function's derivatives mapped over
+    all its calls, compiled where every call is marked `compiled` (and `compile`), else run by CasADi's virtual
+    machine."""
     x, p, n_x, n_g = nlp.x, nlp.p, nlp.x.numel(), nlp.g.numel()
-    groups: dict[int, list[PointCall]] = {}
-    for call in marked:
-        groups.setdefault(id(call.function), []).append(call)
-    A = [ca.jacobian(ca.vertcat(*(ca.vec(v) for v in c.inputs)), x) for calls in groups.values() for c in calls]
-    if any(ca.depends_on(a, ca.vertcat(x, p)) for a in A):
-        return None
-    derivatives = [(_nonzeros(jacobian, f"jac_{i}"), _nonzeros(hessian, f"hess_{i}")) for i, (jacobian, hessian) in
-                   enumerate(_point_derivatives(c[0].function, len(c[0].inputs)) for c in groups.values())]
-    loaded = compiled([function for pair in derivatives for function, _ in pair])
-    if loaded is None:
-        return None
+    groups: dict[int, list[tuple[PointCall, sps.csr_matrix]]] = {}
+    for call, a in mapped:
+        groups.setdefault(id(call.function), []).append((call, a))
+    derivatives, marked = [], []
+    for calls in groups.values():
+        names = (f"jac_{len(marked)}", f"hess_{len(marked)}")  # the compiled ones named alike for every problem
+        point = _point_derivatives(calls[0][0].function, len(calls[0][0].inputs))
+        derivatives.append([_nonzeros(d, name) for d, name in zip(point, names)])
+        if compile and all(call.compiled for call, _ in calls):
+            marked.append(len(derivatives) - 1)
+    loaded = compiled([f for k in marked for f, _ in derivatives[k]]) if marked else None
+    for k, pair in zip(marked, zip(loaded[0::2], loaded[1::2]) if loaded else ()):
+        derivatives[k] = [(f, sparsity) for f, (_, sparsity) in zip(pair, derivatives[k])]
     X, P, lam_g = ca.MX.sym("x", n_x), ca.MX.sym("p", nlp.p.numel()), ca.MX.sym("lam_g", n_g)
     jacobians, hessians, jacobian_places, hessian_places = [], [], [], []
-    placements = iter(ca.evalf(a).sparse() for a in A)
-    for calls, ((_, jacobian_sparsity), (_, hessian_sparsity)), jacobian, hessian in zip(
-            groups.values(), derivatives, loaded[0::2], loaded[1::2]):
-        arguments = _mapped_arguments(calls, x, p)(X, P)
-        weights = ca.reshape(lam_g[np.concatenate([_rows(c) for c in calls]).tolist()], -1, len(calls))
+    for calls, ((jacobian, jacobian_sparsity), (hessian, hessian_sparsity)) in zip(groups.values(), derivatives):
+        arguments = _mapped_arguments([call for call, _ in calls], x, p)(X, P)
+        rows = [_rows(call) for call, _ in calls]
+        weights = ca.reshape(lam_g[np.concatenate(rows).tolist()], -1, len(calls))
         jacobians.append(ca.vec(jacobian.map(len(calls))(*arguments)))
         hessians.append(ca.vec(hessian.map(len(calls))(*arguments, weights)))
-        for call, a in zip(calls, placements):
-            rows = _rows(call)
-            selection = sps.csr_matrix((np.ones(len(rows)), (np.arange(len(rows)), rows)), shape=(len(rows), n_g))
+        for (call, a), r in zip(calls, rows):
+            selection = sps.csr_matrix((np.ones(len(r)), (np.arange(len(r)), r)), shape=(len(r), n_g))
             jacobian_places.append((jacobian_sparsity, selection, a))
             hessian_places.append((hessian_sparsity, a, a))
-    return (ca.Function("compiled_jacobian", [X, P], [_placed(jacobian_places, ca.vertcat(*jacobians), n_g, n_x)]),
-            ca.Function("compiled_hessian", [X, P, lam_g],
+    return (ca.Function("mapped_jacobian", [X, P], [_placed(jacobian_places, ca.vertcat(*jacobians), n_g, n_x)]),
+            ca.Function("mapped_hessian", [X, P, lam_g],
                         [_placed(hessian_places, ca.vertcat(*hessians), n_x, n_x, upper=True)]))
 
 
@@ -147,21 +162,34 @@ def _mapped_arguments(calls: list[PointCall], x: ca.SX, p: ca.SX) -> ca.Function
                                                                 len(calls)) for i, s in enumerate(stacked)])
 
 
-def _placed(places: list[tuple[ca.Sparsity, sps.spmatrix, sps.spmatrix]], nonzeros: ca.MX, rows: int, columns: int,
-            upper: bool = False) -> ca.MX:
+def _placed(places: list[tuple[ca.Sparsity, sps.csr_matrix, sps.csr_matrix]], nonzeros: ca.MX, rows: int,
+            columns: int, upper: bool = False) -> ca.MX:
     """Σ_k L_kᵀ B_k R_k (rows × columns, its upper triangle if `upper`) for places (sparsity of B_k, L_k, R_k), the
-    B_k's nonzeros stacked in `nonzeros`: P · nonzeros on the sum's sparsity (module docstring)."""
-    parts = []
+    B_k's nonzeros stacked in `nonzeros`: P · nonzeros on the sum's sparsity, P's entries L_k[i, r] R_k[j, c] for
+    each nonzero (i, j) of B_k (module docstring)."""
+    targets, sources, weights, offset = [], [], [], 0
     for sparsity, left, right in places:
-        linear = np.asarray(sparsity.get_col()) * sparsity.size1() + np.asarray(sparsity.row())
-        parts.append(sps.kron(right.T, left.T, format="csc")[:, linear])
-    full = sps.hstack(parts, format="csr")
-    reached = np.flatnonzero(np.diff(full.indptr))
-    row, column = reached % rows, reached // rows
-    if upper:
-        reached, row, column = reached[row <= column], row[row <= column], column[row <= column]
-    sparsity = ca.Sparsity.triplet(rows, columns, row.tolist(), column.tolist())
-    return ca.MX(sparsity, ca.mtimes(ca.DM(full[reached].tocsc()), nonzeros))
+        i, j = np.asarray(sparsity.row(), dtype=int), np.asarray(sparsity.get_col(), dtype=int)
+        by_left, r, left_values = _spread(left, i)
+        by_right, c, right_values = _spread(right, j[by_left])
+        r = r[by_right]
+        keep = r <= c if upper else slice(None)
+        targets.append((c * rows + r)[keep])
+        sources.append((offset + by_left[by_right])[keep])
+        weights.append((left_values[by_right] * right_values)[keep])
+        offset += len(i)
+    reached, target = np.unique(np.concatenate(targets), return_inverse=True)
+    P = sps.csc_matrix((np.concatenate(weights), (target, np.concatenate(sources))), shape=(len(reached), offset))
+    sparsity = ca.Sparsity.triplet(rows, columns, (reached % rows).tolist(), (reached // rows).tolist())
+    return ca.MX(sparsity, ca.mtimes(ca.DM(P), nonzeros))
+
+
+def _spread(matrix: sps.csr_matrix, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each entry e of `rows` repeated over the nonzeros of `matrix`'s row rows[e]: (e, their column, their value)."""
+    starts, counts = matrix.indptr[rows], np.diff(matrix.indptr)[rows]
+    owner = np.repeat(np.arange(len(rows)), counts)
+    position = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+    return owner, matrix.indices[position], matrix.data[position]
 
 
 def _chain(calls: list[tuple[PointCall, ca.SX]], x: ca.SX) -> tuple[ca.SX, list[ca.SX], list[ca.SX]]:
