@@ -54,10 +54,11 @@ PATH_CHECKS = OMPL_CHECKS  # configurations the certificate may check: the budge
 
 
 def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
-                    room_to_pass: bool = True) -> Iterator[Problem]:
+                    room_to_pass: bool | None = True) -> Iterator[Problem]:
     """`count` valid random problems for industrial6 with obstacles[0]..obstacles[1] obstacle spheres,
-    deterministic in `seed`, each with a certified collision-free path unless `room_to_pass` is False (module
-    docstring)."""
+    deterministic in `seed`: each with a certified collision-free path (`room_to_pass` True), each without one
+    (False: the draws the suite redraws, where the certificate's search found no path; most are blocked), or every
+    valid draw (None) (module docstring)."""
     rng = np.random.default_rng(seed)
     robot = load_robot("industrial6")
     lower, upper = np.radians(LOWER_DEG), np.radians(UPPER_DEG)
@@ -70,11 +71,15 @@ def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
             validate(problem)
         except ScenarioError:
             continue
-        if room_to_pass and joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS,
-                                       max_step=None) is None:
+        if room_to_pass is not None and room_to_pass != _passable(problem):
             continue
         count -= 1
         yield problem
+
+
+def _passable(problem: Problem) -> bool:
+    """Whether the room-to-pass certificate's search connects `problem`'s start and goal (module docstring)."""
+    return joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS, max_step=None) is not None
 
 
 def _obstacles(rng: np.random.Generator, robot: Robot, start: np.ndarray, goal: np.ndarray,
@@ -100,14 +105,15 @@ def _near(rng: np.random.Generator, robot: Robot, start: np.ndarray, goal: np.nd
 
 def run_random(seed: int = 1, count: int = 30, knots: int = 12, obstacles: tuple[int, int] = (1, 1),
                out: Path | None = None, fallbacks: Sequence[Rung] = DEFAULT_LADDER,
-               planner: str = "simultaneous") -> Counter:
+               planner: str = "simultaneous", blocked: bool = False) -> Counter:
     """Plan `count` random problems of `seed` (with `obstacles` spheres) with the simultaneous planner's defaults
     at `knots` and the ladder `fallbacks` (SINGLE_SHOT: the paper's one solve); print a line per problem, the
     summary and which rung verified how many; with `out`, write results.csv, the trajectories and the scenarios
     there. Returns the status counts. Another `planner` (e.g. "ompl-topp3") plans them with its defaults instead
-    (`knots` and `fallbacks` are the simultaneous planner's)."""
+    (`knots` and `fallbacks` are the simultaneous planner's). `blocked`: the draws without room to pass instead
+    (`random_problems`), where a plan should end `no_path` with the checks it spent, within its budget."""
     statuses, rungs, verified_times, rows = Counter(), Counter(), [], []
-    for problem in random_problems(seed, count, obstacles):
+    for problem in random_problems(seed, count, obstacles, room_to_pass=not blocked):
         own = {"knots": knots, "fallbacks": fallbacks} if planner == "simultaneous" else {}
         result = plan(problem, planner, **own)
         statuses[result.status] += 1

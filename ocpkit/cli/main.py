@@ -126,7 +126,8 @@ def _bench_command(args: argparse.Namespace) -> int:
         from ocpkit.planner.ladder import DEFAULT_LADDER, SINGLE_SHOT
 
         run_random(args.seed, args.count, _one_knot_count(args, "chebyshev"), obstacles=tuple(args.obstacles),
-                   out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER, planner=args.planner)
+                   out=out, fallbacks=SINGLE_SHOT if args.single_shot else DEFAULT_LADDER, planner=args.planner,
+                   blocked=args.blocked)
     elif args.suite == "shapes":
         from ocpkit.bench.shapes import run_shapes_benchmark
 
@@ -281,6 +282,8 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--single-shot", action="store_true", help="random: plan without the fallback ladder (the "
                    "paper's one solve; bench paper always plans so)")
     b.add_argument("--planner", default="simultaneous", help="random: the planner (default simultaneous)")
+    b.add_argument("--blocked", action="store_true", help="random: the draws whose obstacles leave no room to pass "
+                   "(the certificate's search found no path) instead of those with room")
     add_run_arguments(b)
     b.add_argument("--quick", action="store_true", help="perf: 2 repeats and a short growth curve (for tests)")
     b.set_defaults(run=_bench_command)

@@ -22,9 +22,11 @@ continuation rung solves the problem relaxed first (a softened margin, wider lim
 The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
 shot finds in time.
 
-The default budget, MAX_WALL_TIME, leaves room for the first three rungs on a hard problem (MotionBenchMaker's
-shelves and cages: the capped first rung and two OMPL rungs, each a path search and its solves). A verified
-plan returns at once; the budget is what a failure costs.
+The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an OMPL rung on a hard problem
+(MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified
+plan returns at once; the budget is what a failure costs. A ladder that verifies nothing after an OMPL rung
+found no path ends `no_path`, with the configurations that search checked: where the obstacles leave no way
+through, that is the evidence, and no failed solve says more.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
@@ -49,7 +51,7 @@ if TYPE_CHECKING:
     from ocpkit.planner.options import SimultaneousOptions
 
 MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
-MAX_WALL_TIME = 90.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
+MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 
@@ -195,11 +197,15 @@ def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:
 
 def _combined(tried: list[tuple[Rung, Plan]], skipped: list[str]) -> Plan:
     """The best plan of `tried` (rung, plan) pairs, its times and iterations summed over all of them, the rungs
-    tried and the names of the `skipped` ones in its stats, and its method and message naming its rung; its hint
-    NO_PATH_HINT if it failed and OMPL found no path."""
+    tried and the names of the `skipped` ones in its stats, and its method and message naming its rung. When none
+    verified and an OMPL rung's search found no path, that rung's `no_path` plan instead (its message: the checks
+    the search spent), with the hint NO_PATH_HINT."""
     rung, best = min(tried, key=lambda pair: rank(pair[1]))
     plans = [p for _, p in tried]
-    no_path = not best.ok and any(p.status == "no_path" for p in plans)
+    searched = [(r, p) for r, p in tried if p.status == "no_path" and r.guess == "ompl"]
+    no_path = not best.ok and bool(searched)
+    if no_path:  # the failed search is the evidence a failed solve is not
+        rung, best = searched[-1]
     stats = dataclasses.replace(
         best.stats, solve_time=sum(p.stats.solve_time for p in plans),
         setup_time=sum(p.stats.setup_time for p in plans), iterations=sum(p.stats.iterations for p in plans),

@@ -19,8 +19,8 @@ def test_the_original_suite_keeps_its_problems():
 
 
 def test_more_obstacles_are_seeded_and_within_the_range():
-    problems = list(random_problems(100, 30, (1, 3), room_to_pass=False))
-    again = list(random_problems(100, 30, (1, 3), room_to_pass=False))
+    problems = list(random_problems(100, 30, (1, 3), room_to_pass=None))
+    again = list(random_problems(100, 30, (1, 3), room_to_pass=None))
     counts = [len(p.scene.obstacle_radii) for p in problems]
     assert set(counts) == {1, 2, 3}
     assert all(np.array_equal(p.scene.obstacle_centers, q.scene.obstacle_centers) for p, q in zip(problems, again))
@@ -30,7 +30,7 @@ def test_more_obstacles_are_seeded_and_within_the_range():
 
 def test_the_obstacles_are_in_the_way_of_the_straight_path():
     """Each problem's straight joint-space path passes within 0.3 m of every obstacle with some robot sphere."""
-    for problem in random_problems(100, 10, (2, 3), room_to_pass=False):
+    for problem in random_problems(100, 10, (2, 3), room_to_pass=None):
         path = np.linspace(problem.start, problem.goal, 41)
         centres = sphere_centers(problem.robot, path)[:, PATH_SPHERES]  # (41, k, 3)
         for obstacle in problem.scene.obstacle_centers:
@@ -43,7 +43,7 @@ def test_the_obstacles_are_in_the_way_of_the_straight_path():
 def test_problems_without_room_to_pass_are_redrawn(monkeypatch):
     """A problem whose certificate finds no path is replaced by the next draw; the others are kept as drawn."""
     # seed 10: its first draws are certified at once (seed 100's second exhausts the certificate's budget, ~40 s)
-    drawn = list(random_problems(10, 3, (1, 3), room_to_pass=False))
+    drawn = list(random_problems(10, 3, (1, 3), room_to_pass=None))
     certified = list(random_problems(10, 2, (1, 3)))
     assert [p.name for p in certified] == ["random2", "random1"]
     np.testing.assert_array_equal(certified[0].start, drawn[0].start)
@@ -70,3 +70,11 @@ def test_run_random_writes_results_trajectories_and_scenarios(tmp_path, capsys):
     assert len(list((tmp_path / "scenarios").glob("*.yaml"))) == 2
     printed = capsys.readouterr().out
     assert "90th percentile" in printed or "no verified plan" in printed
+
+
+def test_blocked_draws_are_the_ones_the_certificate_rejects(monkeypatch):
+    drawn = list(random_problems(10, 3, (1, 3), room_to_pass=None))
+    monkeypatch.setattr(suite, "joint_path", lambda problem, **options: None if np.array_equal(
+        problem.start, drawn[1].start) else np.stack([problem.start, problem.goal]))
+    blocked = next(random_problems(10, 1, (1, 3), room_to_pass=False))
+    np.testing.assert_array_equal(blocked.start, drawn[1].start)

@@ -199,7 +199,8 @@ def test_single_shot_on_the_command_line_means_no_fallbacks():
 def test_a_failed_ladder_where_ompl_found_no_path_says_so():
     script = Script({"a": fake("infeasible"), "b": fake("no_path"), "c": fake("iteration_limit")})
     result = climb(script, LADDER, 60.0)
-    assert result.status == "infeasible" and result.hint == NO_PATH_HINT
+    assert result.status == "no_path" and result.hint == NO_PATH_HINT  # the search's evidence, not rung a's failure
+    assert result.method["rung"] == "b" and result.stats.solver_message == "rung b: no_path message"
     assert [r.status for r in result.stats.rungs] == ["infeasible", "no_path", "iteration_limit"]
     assert result.stats.hint == NO_PATH_HINT and result.stats.figures()["hint"] == NO_PATH_HINT
     script = Script({"a": fake("no_path"), "b": fake("verified")})
