@@ -121,8 +121,7 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, sps.csr_matrix]],
     derivatives, marked = [], []
     for calls in groups.values():
         names = (f"jac_{len(marked)}", f"hess_{len(marked)}")  # the compiled ones named alike for every problem
-        point = _point_derivatives(calls[0][0].function, len(calls[0][0].inputs))
-        derivatives.append([_nonzeros(d, name) for d, name in zip(point, names)])
+        derivatives.append(_point_nonzeros(calls[0][0].function, len(calls[0][0].inputs), names))
         if compile and all(call.compiled for call, _ in calls):
             marked.append(len(derivatives) - 1)
     loaded = compiled([f for k in marked for f, _ in derivatives[k]]) if marked else None
@@ -143,13 +142,6 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, sps.csr_matrix]],
     return (ca.Function("mapped_jacobian", [X, P], [_placed(jacobian_places, ca.vertcat(*jacobians), n_g, n_x)]),
             ca.Function("mapped_hessian", [X, P, lam_g],
                         [_placed(hessian_places, ca.vertcat(*hessians), n_x, n_x, upper=True)]))
-
-
-def _nonzeros(function: ca.Function, name: str) -> tuple[ca.Function, ca.Sparsity]:
-    """(`function` renamed `name` with its one output as the column of its nonzeros, that output's sparsity)."""
-    symbols = function.sx_in()
-    out = function(*symbols)
-    return ca.Function(name, symbols, [out.nz[:]]), out.sparsity()
 
 
 def _mapped_arguments(calls: list[PointCall], x: ca.SX, p: ca.SX) -> ca.Function:
@@ -224,9 +216,24 @@ def _second_order(calls: list[tuple[PointCall, ca.SX]], jacobians: list[ca.SX], 
 def _point_derivatives(function: ca.Function, differentiated: int) -> tuple[ca.Function, ca.Function]:
     """(∂F/∂z, ∇²_z(λᵀF)) of a point function F whose first `differentiated` inputs make z, as Functions of F's
     inputs (and λ, one per output row)."""
+    symbols, lam, jacobian, hessian = _derivative_expressions(function, differentiated)
+    return (ca.Function("point_jacobian", symbols, [jacobian]),
+            ca.Function("point_hessian", [*symbols, lam], [hessian]))
+
+
+def _point_nonzeros(function: ca.Function, differentiated: int,
+                    names: tuple[str, str]) -> list[tuple[ca.Function, ca.Sparsity]]:
+    """As `_point_derivatives`, each derivative as (a Function so named whose one output is the column of its
+    nonzeros, its sparsity)."""
+    symbols, lam, jacobian, hessian = _derivative_expressions(function, differentiated)
+    return [(ca.Function(name, inputs, [d.nz[:]]), d.sparsity())
+            for name, inputs, d in zip(names, (symbols, [*symbols, lam]), (jacobian, hessian))]
+
+
+def _derivative_expressions(function: ca.Function, differentiated: int) -> tuple[list[ca.SX], ca.SX, ca.SX, ca.SX]:
+    """(F's input symbols, λ, ∂F/∂z, ∇²_z(λᵀF)) for `_point_derivatives`."""
     symbols = [ca.SX.sym(function.name_in(i), function.size_in(i)) for i in range(function.n_in())]
     rows = function(*symbols)
     z = ca.vertcat(*(ca.vec(s) for s in symbols[:differentiated]))
     lam = ca.SX.sym("lam", rows.numel())
-    return (ca.Function("point_jacobian", symbols, [ca.jacobian(rows, z)]),
-            ca.Function("point_hessian", [*symbols, lam], [ca.hessian(ca.dot(lam, rows), z)[0]]))
+    return symbols, lam, ca.jacobian(rows, z), ca.hessian(ca.dot(lam, rows), z)[0]
