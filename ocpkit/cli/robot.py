@@ -86,7 +86,7 @@ def _check_fit_options(args: argparse.Namespace) -> None:
 
 
 def _import_command(args: argparse.Namespace) -> int:
-    from ocpkit.robots.importer import import_urdf, pair_report, write_spec
+    from ocpkit.robots.importer import import_urdf, pair_report, spec_header, write_spec
     from ocpkit.robots.sphere_models import sphere_model
 
     _check_fit_options(args)
@@ -103,11 +103,7 @@ def _import_command(args: argparse.Namespace) -> int:
                            overrides=_overrides(args.set))
     print(report)
     print(pair_report(imported.pairs))
-    header = (f"{imported.spec['name']}: imported by `ocpkit robot import` from {urdf.name} "
-              f"(spheres: {args.spheres}).\n"
-              "Limits from the URDF; torque rate = 10/s x torque limit, gear ratio = floor(418.9 rad/s / velocity "
-              "limit),\nfriction zero, unless overridden (ocpkit.robots.importer). Self-collision:\n"
-              + pair_report(imported.pairs))
+    header = spec_header(imported, urdf, args.spheres, "`ocpkit robot import`")
     print(f"wrote {write_spec(imported, Path(args.out), header).resolve()}")
     return 0
 

@@ -12,6 +12,9 @@ checks. Layout of DIR (default ~/.cache/ocpkit/mbm, or $XDG_CACHE_HOME/ocpkit/mb
     <robot>/moveit/problems/...        the MoveIt YAML pairs, as shipped
     <robot>/<scene>/NNNN.yaml          the scenarios
     <robot>/invalid.txt                problems ocpkit's model of the robot rejects, with the reason
+    <robot>/robot/spec.yaml            a robot ocpkit does not build in (Fetch), imported from vamp's URDF, SRDF and
+                                       spherized URDF (beside it) as `ocpkit robot import` does; its scenarios
+                                       name it as `robot: {spec: ../robot/spec.yaml}`
 
 MBM scenes have no workspace box: their tables, shelves and cages are obstacles, and MoveIt's
 `workspace_parameters` bound a mobile base's virtual joint, not the arm.
@@ -34,6 +37,9 @@ from ocpkit.errors import OcpkitError, RobotError
 from ocpkit.formats.moveit import read_moveit, resolve_robot, scenario_text
 from ocpkit.formats.scenario import load_scenario
 from ocpkit.formats.schema import one_line
+from ocpkit.robots import load_robot
+from ocpkit.robots.importer import import_urdf, spec_header, write_spec
+from ocpkit.robots.sphere_models import sphere_model
 
 VAMP_VERSION = "0.6.4"
 """The vamp-planner release whose problems.tar.bz2 files are read (pinned: the same problems on every machine)."""
@@ -81,7 +87,8 @@ def fetch_mbm(robot: str, directory: Path | None = None, progress: bool = True) 
     try:
         sdist = download_vamp(directory)
         problems = unpack_problems(sdist, robot, directory)
-        return convert_problems(robot, problems, directory / robot, progress)
+        spec = None if _built_in(robot) else import_robot(sdist, robot, directory / robot / "robot")
+        return convert_problems(robot, problems, directory / robot, progress, spec)
     except OSError as exc:  # a folder that cannot be written, a full disk
         raise DataError(f"cannot write the MBM cache: {exc.filename or directory}: {exc.strerror}") from exc
 
@@ -129,6 +136,40 @@ def unpack_problems(sdist: Path, robot: str, directory: Path) -> Path:
     return moveit / "problems"
 
 
+def _built_in(robot: str) -> bool:
+    """Whether ocpkit has `robot` built in."""
+    try:
+        load_robot(robot)
+    except RobotError:
+        return False
+    return True
+
+
+def import_robot(sdist: Path, robot: str, folder: Path) -> Path:
+    """folder/spec.yaml of `robot` (not built in here), imported unless already there: vamp's <robot>.urdf,
+    <robot>.srdf (its pairs that never collide) and <robot>_spherized.urdf (its spheres) taken out of the sdist into
+    `folder`, MBM_JOINTS[robot] planned, the other joints locked at 0 (ocpkit.robots.importer)."""
+    spec = folder / "spec.yaml"
+    if spec.is_file():
+        return spec
+    names = (f"{robot}.urdf", f"{robot}.srdf", f"{robot}_spherized.urdf")
+    try:
+        with tarfile.open(sdist) as outer:
+            members = {Path(*Path(m.name).parts[1:]).as_posix(): m for m in outer.getmembers() if m.isfile()}
+            missing = [n for n in names if f"resources/{robot}/{n}" not in members]
+            if missing:
+                raise DataError(f"{sdist} has no resources/{robot}/{missing[0]}: not a vamp-planner sdist?")
+            folder.mkdir(parents=True, exist_ok=True)
+            for name in names:
+                (folder / name).write_bytes(outer.extractfile(members[f"resources/{robot}/{name}"]).read())
+    except (tarfile.TarError, EOFError) as exc:
+        raise DataError(f"cannot read {robot}'s URDF from {sdist}: {one_line(str(exc))}") from exc
+    urdf, srdf, spherized = (folder / name for name in names)
+    spheres, _ = sphere_model(urdf, str(spherized))
+    imported = import_urdf(urdf, spheres, folder, joints=MBM_JOINTS[robot], srdf=srdf)
+    return write_spec(imported, folder, spec_header(imported, urdf, spherized.name, "`ocpkit data mbm`"))
+
+
 def _extract(archive: tarfile.TarFile, target: Path) -> None:
     """Extract the regular files of `archive` below `target`, refusing any path that leaves it."""
     target.mkdir(parents=True, exist_ok=True)
@@ -142,40 +183,61 @@ def _extract(archive: tarfile.TarFile, target: Path) -> None:
             path.write_bytes(archive.extractfile(member).read())
 
 
-def convert_problems(robot: str, problems: Path, out: Path, progress: bool = True) -> MbmSummary:
+def convert_problems(robot: str, problems: Path, out: Path, progress: bool = True,
+                     spec: Path | None = None) -> MbmSummary:
     """Convert every problems/<scene>_<robot>/sceneNNNN.yaml + requestNNNN.yaml to out/<scene>/NNNN.yaml (files
-    already there are kept) and, when ocpkit has `robot` built in, load each (validation) and list the rejected
-    ones in out/invalid.txt."""
+    already there are kept unless they name another robot entry) for `robot` built in, or for the robot of `spec`
+    (a spec.yaml); load each (validation) and list the rejected ones in out/invalid.txt. A robot neither built in
+    nor given by a spec is written by name in MBM's joint order, unvalidated."""
     pairs = sorted((scene, request) for scene in SCENES
                    for request in (problems / f"{scene}_{robot}").glob("request*.yaml"))
     if not pairs:
         raise DataError(f"no MBM problems under {problems}")
     written = kept = 0
     rejected: list[str] = []
-    try:
-        field, joints, loaded = resolve_robot(robot, out)
-    except RobotError:  # not built in here: the MBM joint order, no validation
-        field, joints, loaded = robot, MBM_JOINTS[robot], None
+    entries: dict[str, tuple] = {}  # per scene folder: resolve_robot's answer, the spec's path relative to it
     for scene, request in tqdm(pairs, desc=f"MBM {robot}", unit="problem", disable=not progress):
+        if scene not in entries:
+            entries[scene] = _robot_entry(robot, spec, out / scene)
+        field, joints, loaded = entries[scene]
         number = request.stem.removeprefix("request")
         target = out / scene / f"{number}.yaml"
-        if target.is_file():
-            kept += 1
-        else:
+        text = None
+        if not _names(target, field):
             conversion = read_moveit(request.with_name(f"scene{number}.yaml"), request, joints, field,
                                      f"{scene}_{number}")
-            target.parent.mkdir(parents=True, exist_ok=True)
             source = f"{robot}/moveit/problems/{scene}_{robot}/{{scene,request}}{number}.yaml"
             notice = [line.format(version=VAMP_VERSION, robot=robot) for line in NOTICE]
+            text = scenario_text(conversion, [*notice, f"Source: {source}"])
+            target.parent.mkdir(parents=True, exist_ok=True)
             partial = target.with_suffix(".part")  # renamed when complete: an interrupted run leaves no half file
-            partial.write_text(scenario_text(conversion, [*notice, f"Source: {source}"]))
+            partial.write_text(text)
             partial.replace(target)
-            written += 1
+        written, kept = written + (text is not None), kept + (text is None)
         if loaded is not None:
             try:
                 load_scenario(target)
             except OcpkitError as exc:
                 rejected.append(f"{exc}")
-    if loaded is not None:
+    validated = any(loaded is not None for _, _, loaded in entries.values())
+    if validated:
         (out / "invalid.txt").write_text("".join(f"{line}\n" for line in rejected))
-    return MbmSummary(out, written, kept, len(rejected) if loaded is not None else None)
+    return MbmSummary(out, written, kept, len(rejected) if validated else None)
+
+
+def _robot_entry(robot: str, spec: Path | None, folder: Path) -> tuple:
+    """resolve_robot's (scenario entry, joints, Robot or None) for scenarios in `folder`."""
+    try:
+        return resolve_robot(str(spec) if spec is not None else robot, folder)
+    except RobotError:  # not built in here and no spec: the MBM joint order, no validation
+        if spec is not None:
+            raise
+        return robot, MBM_JOINTS[robot], None
+
+
+def _names(target: Path, field: str | dict) -> bool:
+    """Whether the scenario file `target` exists and names the robot entry `field` (a conversion to keep)."""
+    if not target.is_file():
+        return False
+    entry = field if isinstance(field, str) else "{" + ", ".join(f"{k}: {v}" for k, v in field.items()) + "}"
+    return f"\nrobot: {entry}\n" in target.read_text()

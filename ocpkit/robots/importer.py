@@ -151,6 +151,15 @@ def _apply(values: np.ndarray, key: str, joints: list[str], overrides: dict[str,
         values[joints.index(joint)] = value
 
 
+def spec_header(imported: Imported, urdf: Path, spheres: str, by: str) -> str:
+    """The comment above an imported spec.yaml: what made it (`by`), from which URDF and `spheres` source, the
+    rules its values follow, and the self-collision pairs dropped."""
+    return (f"{imported.spec['name']}: imported by {by} from {Path(urdf).name} (spheres: {spheres}).\n"
+            "Limits from the URDF; torque rate = 10/s x torque limit, gear ratio = floor(418.9 rad/s / velocity "
+            "limit),\nfriction zero, unless overridden (ocpkit.robots.importer). Self-collision:\n"
+            + pair_report(imported.pairs))
+
+
 def write_spec(imported: Imported, out_dir: Path, header: str) -> Path:
     """Write `imported.spec` to out_dir/spec.yaml under the comment `header`; the path written."""
     comment = "".join(f"# {line}\n".replace("# \n", "#\n") for line in header.splitlines())

@@ -36,12 +36,16 @@ def tar_bytes(files: dict[str, bytes], mode: str) -> bytes:
     return buffer.getvalue()
 
 
-def fake_sdist(directory: Path, problems: dict[str, bytes]) -> Path:
-    """A vamp_planner-VERSION.tar.gz in `directory` holding LICENSE.txt and resources/panda/problems.tar.bz2."""
+def fake_sdist(directory: Path, problems: dict[str, bytes], robot: str = "panda",
+               files: dict[str, bytes] | None = None) -> Path:
+    """A vamp_planner-VERSION.tar.gz in `directory` holding LICENSE.txt, resources/<robot>/problems.tar.bz2 and
+    `files` (name → content) in resources/<robot>/."""
     inner = tar_bytes(problems, "w:bz2")
     root = f"vamp_planner-{VAMP_VERSION}"
     outer = tar_bytes({f"{root}/LICENSE.txt": b"Apache License 2.0 (stand-in)\n",
-                       f"{root}/resources/panda/problems.tar.bz2": inner}, "w:gz")
+                       f"{root}/resources/{robot}/problems.tar.bz2": inner,
+                       **{f"{root}/resources/{robot}/{name}": content for name, content in (files or {}).items()}},
+                      "w:gz")
     directory.mkdir(parents=True, exist_ok=True)
     path = directory / f"{root}.tar.gz"
     path.write_bytes(outer)
@@ -69,6 +73,27 @@ def test_a_cached_sdist_is_unpacked_converted_and_reused(tmp_path, capsys):
     assert main(["data", "mbm", "--robot", "panda", "--dir", str(tmp_path)]) == 0  # second run: nothing redone
     assert "0 scenarios written, 1 already there" in capsys.readouterr().out
     assert target.read_text() == text
+
+
+def test_a_robot_not_built_in_is_imported_from_the_sdist_and_named_by_its_spec(tmp_path, capsys):
+    """Fetch: vamp's URDF, SRDF and spherized URDF imported once into fetch/robot/, every scenario naming that spec
+    relative to its own folder, validated against it; a scenario written before, naming the robot, is redone."""
+    vamp = REPO / "tests/robots/vamp"
+    folder = "problems/box_fetch"
+    problem = {f"{folder}/scene0001.yaml": (DATA / "mbm_box_fetch_scene0001.yaml").read_bytes(),
+               f"{folder}/request0001.yaml": (DATA / "mbm_box_fetch_request0001.yaml").read_bytes()}
+    files = {name: (vamp / name).read_bytes() for name in ("fetch.urdf", "fetch.srdf", "fetch_spherized.urdf")}
+    fake_sdist(tmp_path, problem, "fetch", files)
+    target = tmp_path / "fetch/box/0001.yaml"
+    target.parent.mkdir(parents=True)
+    target.write_text("name: box_0001\nrobot: fetch\n")  # an earlier conversion, by name
+    summary = fetch_mbm("fetch", tmp_path, progress=False)
+    assert (summary.written, summary.kept, summary.invalid) == (1, 0, 0)
+    assert yaml.safe_load(target.read_text())["robot"] == {"spec": "../robot/spec.yaml"}
+    scenario = load_scenario(target)
+    assert list(scenario.robot.joint_names) == MBM_JOINTS["fetch"] and len(scenario.robot.sphere_radius) == 111
+    assert main(["data", "mbm", "--robot", "fetch", "--dir", str(tmp_path)]) == 0
+    assert "0 scenarios written, 1 already there" in capsys.readouterr().out
 
 
 def test_an_archive_member_outside_the_cache_is_refused(tmp_path):
