@@ -16,12 +16,14 @@ shared by several calls (the values at one point) are differentiated once. The o
 interpolation defects, nearly linear) are differentiated by CasADi a few rows at a time, and the objective too
 when it is not a point call. The result equals CasADi's own derivatives (tests/solvers/test_pointwise.py).
 
-Calls whose inputs are linear in x (A_k constant: every robot OCP's point calls) are not inlined: each distinct
+Calls whose inputs are linear in x (A_k constant, or a function of the parameters p alone: a check point whose
+time is a parameter) are not inlined: each distinct
 point function's derivatives are built once, evaluated over all its points by one mapped call, and joined by
 constant sparse matrices, blocks B_k placed as Σ_k L_kᵀ B_k R_k (L_k, R_k: row selections or A_k), whose
 nonzeros are P times the blocks' stacked nonzeros, P's entries L_k[i, r] R_k[j, c] per nonzero (i, j) of B_k.
 Inlining them cost most of the set-up on a large NLP (a copy of a point Hessian per point), the mapped call
-evaluates as fast. Calls marked `compiled` (the dynamics rows: their point function depends on the robot and the
+evaluates as fast. A parametric A_k(p) joins by MX products instead, Sₖ B_k A_k(p) and A_k(p)ᵀ H_k A_k(p); the
+objective, when it is a point call, joins the same way with λ_f. Calls marked `compiled` (the dynamics rows: their point function depends on the robot and the
 OCP only, so its C is the same for every problem of a robot) run their point derivatives compiled to C
 (ocpkit.solvers.compiled), CasADi's virtual machine where nothing compiles. Calls with inputs not linear in x
 (a torque with friction, a path-timing OCP's state) take the SX graph.
@@ -46,21 +48,39 @@ def pointwise_derivatives(nlp: NLP, compile: bool = True) -> dict[str, ca.Functi
     """IPOPT's {"jac_g": (x, p) → (g, ∂g/∂x), "hess_lag": (x, p, λ_f, λ_g) → upper triangle of
     ∇²ₓ(λ_f f + λ_gᵀ g)} for `nlp` (SX, with point calls), built as the module docstring says; `compile`: the
     calls marked `compiled` through compiled point functions."""
-    maps = [_input_map(call, nlp) for call in nlp.point_calls]
-    mapped = [(call, a) for call, a in zip(nlp.point_calls, maps) if a is not None]
-    kept = [call for call, a in zip(nlp.point_calls, maps) if a is None]
-    if not mapped:
-        return _graph_derivatives(nlp, kept, np.zeros(0, dtype=int))
-    left = np.concatenate([_rows(call) for call, _ in mapped])
-    return _joined(nlp, _graph_derivatives(nlp, kept, left), _mapped_terms(nlp, mapped, compile))
+    maps: dict[tuple[int, ...], InputMap] = {}  # by the inputs' identities: calls at a point share them
+
+    def input_map(call: PointCall) -> InputMap:
+        key = tuple(map(id, call.inputs))
+        if key not in maps:
+            maps[key] = _input_map(call, nlp)
+        return maps[key]
+
+    mapped = [(call, a) for call in nlp.point_calls if (a := input_map(call)) is not None]
+    kept = [call for call in nlp.point_calls if input_map(call) is None]
+    objective = nlp.objective_call
+    objective_map = None if objective is None else input_map(objective)
+    objective_map = objective_map if isinstance(objective_map, sps.csr_matrix) else None  # placed as a constant
+    if not mapped and objective_map is None:
+        return _graph_derivatives(nlp, kept, np.zeros(0, dtype=int), objective)
+    left = np.concatenate([np.zeros(0, dtype=int), *(_rows(call) for call, _ in mapped)])
+    graphs = _graph_derivatives(nlp, kept, left, objective if objective_map is None else None)
+    terms = _mapped_terms(nlp, mapped, None if objective_map is None else (objective, objective_map), compile)
+    return _joined(nlp, graphs, terms)
 
 
-def _input_map(call: PointCall, nlp: NLP) -> sps.csr_matrix | None:
-    """A = ∂z/∂x of `call`'s inputs z as a constant sparse matrix (rows of z × n_w), or None when z is not linear
-    in x (A depends on x or p)."""
+InputMap = sps.csr_matrix | ca.SX | None
+"""A call's A = ∂z/∂x: a constant sparse matrix, an SX matrix of the parameters p only (a check point whose time is
+a parameter: z is linear in x with coefficients set by p), or None (z not linear in x)."""
+
+
+def _input_map(call: PointCall, nlp: NLP) -> InputMap:
+    """`call`'s A = ∂z/∂x (InputMap)."""
     a = ca.jacobian(ca.vertcat(*(ca.vec(v) for v in call.inputs)), nlp.x)
-    if ca.depends_on(a, ca.vertcat(nlp.x, nlp.p)):
+    if ca.depends_on(a, nlp.x):
         return None
+    if ca.depends_on(a, nlp.p):
+        return a
     return sps.csr_matrix(ca.evalf(a).sparse())
 
 
@@ -69,14 +89,16 @@ def _rows(call: PointCall) -> np.ndarray:
     return np.arange(call.first_row, call.first_row + call.function.numel_out(0))
 
 
-def _graph_derivatives(nlp: NLP, point_calls: list[PointCall], left: np.ndarray) -> dict[str, ca.Function]:
-    """The derivatives as SX graphs, of g's rows less `left` (rows another term gives: zero here)."""
+def _graph_derivatives(nlp: NLP, point_calls: list[PointCall], left: np.ndarray,
+                       objective_call: PointCall | None) -> dict[str, ca.Function]:
+    """The derivatives as SX graphs, of g's rows less `left` (rows another term gives: zero here), the objective's
+    through `objective_call` if given, not at all if the NLP has a call for it elsewhere (mapped)."""
     x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
     lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g.numel())
     rows = [_rows(c) for c in point_calls]
     calls = [*zip(point_calls, (lam_g[r.tolist()] for r in rows))]
-    if nlp.objective_call is not None:
-        calls.append((nlp.objective_call, lam_f))
+    if objective_call is not None:
+        calls.append((objective_call, lam_f))
     A, jacobians, hessians = _chain(calls, x)
     called = np.concatenate([*rows, left]).astype(int)
     others = np.setdiff1d(np.arange(g.numel()), called).tolist()
@@ -102,20 +124,23 @@ def _joined(nlp: NLP, graphs: dict[str, ca.Function],
     x, p = ca.MX.sym("x", nlp.x.numel()), ca.MX.sym("p", nlp.p.numel())
     lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", nlp.g.numel())
     g, jac = graphs["jac_g"](x, p)
-    hess = graphs["hess_lag"](x, p, lam_f, lam_g) + terms[1](x, p, lam_g)
+    hess = graphs["hess_lag"](x, p, lam_f, lam_g) + terms[1](x, p, lam_f, lam_g)
     return {"jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac + terms[0](x, p)], ["x", "p"], ["g", "jac_g_x"]),
             "hess_lag": ca.Function("nlp_hess_l", [x, p, lam_f, lam_g], [hess],
                                     ["x", "p", "lam_f", "lam_g"], ["hess_gamma_x_x"])}
 
 
-def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, sps.csr_matrix]],
+def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
+                  objective: tuple[PointCall, sps.csr_matrix] | None,
                   compile: bool) -> tuple[ca.Function, ca.Function]:
-    """MX Functions (x, p → the `mapped` calls' rows of ∂g/∂x; x, p, λ_g → their part of the Hessian's upper
-    triangle) for calls with constant input maps A (module docstring): one point function's derivatives mapped over
-    all its calls, compiled where every call is marked `compiled` (and `compile`), else run by CasADi's virtual
-    machine."""
+    """MX Functions (x, p → the `mapped` calls' rows of ∂g/∂x; x, p, λ_f, λ_g → their part, and the `objective`
+    call's, of the Hessian's upper triangle) for calls with constant input maps A (module docstring): one point
+    function's derivatives mapped over all its calls, compiled where every call is marked `compiled` (and
+    `compile`), else run by CasADi's virtual machine."""
     x, p, n_x, n_g = nlp.x, nlp.p, nlp.x.numel(), nlp.g.numel()
-    groups: dict[int, list[tuple[PointCall, sps.csr_matrix]]] = {}
+    X, P = ca.MX.sym("x", n_x), ca.MX.sym("p", nlp.p.numel())
+    lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", n_g)
+    groups: dict[int, list[tuple[PointCall, InputMap]]] = {}
     for call, a in mapped:
         groups.setdefault(id(call.function), []).append((call, a))
     derivatives, marked = [], []
@@ -127,21 +152,39 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, sps.csr_matrix]],
     loaded = compiled([f for k in marked for f, _ in derivatives[k]]) if marked else None
     for k, pair in zip(marked, zip(loaded[0::2], loaded[1::2]) if loaded else ()):
         derivatives[k] = [(f, sparsity) for f, (_, sparsity) in zip(pair, derivatives[k])]
-    X, P, lam_g = ca.MX.sym("x", n_x), ca.MX.sym("p", nlp.p.numel()), ca.MX.sym("lam_g", n_g)
     jacobians, hessians, jacobian_places, hessian_places = [], [], [], []
+    jacobian_sums, hessian_sums = [], []  # the terms of calls with parametric A, as MX matrices
     for calls, ((jacobian, jacobian_sparsity), (hessian, hessian_sparsity)) in zip(groups.values(), derivatives):
         arguments = _mapped_arguments([call for call, _ in calls], x, p)(X, P)
         rows = [_rows(call) for call, _ in calls]
         weights = ca.reshape(lam_g[np.concatenate(rows).tolist()], -1, len(calls))
-        jacobians.append(ca.vec(jacobian.map(len(calls))(*arguments)))
-        hessians.append(ca.vec(hessian.map(len(calls))(*arguments, weights)))
-        for (call, a), r in zip(calls, rows):
-            selection = sps.csr_matrix((np.ones(len(r)), (np.arange(len(r)), r)), shape=(len(r), n_g))
-            jacobian_places.append((jacobian_sparsity, selection, a))
-            hessian_places.append((hessian_sparsity, a, a))
-    return (ca.Function("mapped_jacobian", [X, P], [_placed(jacobian_places, ca.vertcat(*jacobians), n_g, n_x)]),
-            ca.Function("mapped_hessian", [X, P, lam_g],
-                        [_placed(hessian_places, ca.vertcat(*hessians), n_x, n_x, upper=True)]))
+        blocks = jacobian.map(len(calls))(*arguments), hessian.map(len(calls))(*arguments, weights)
+        constant = [k for k, (_, a) in enumerate(calls) if isinstance(a, sps.csr_matrix)]
+        jacobians.append(ca.vec(blocks[0][:, constant]))
+        hessians.append(ca.vec(blocks[1][:, constant]))
+        for k in constant:
+            selection = sps.csr_matrix((np.ones(len(rows[k])), (np.arange(len(rows[k])), rows[k])),
+                                       shape=(len(rows[k]), n_g))
+            jacobian_places.append((jacobian_sparsity, selection, calls[k][1]))
+            hessian_places.append((hessian_sparsity, calls[k][1], calls[k][1]))
+        parametric = [k for k in range(len(calls)) if k not in constant]
+        maps = ca.Function("input_maps", [p], [calls[k][1] for k in parametric]).call([P]) if parametric else []
+        for k, a in zip(parametric, maps):
+            selection = ca.MX(ca.DM(sps.csc_matrix((np.ones(len(rows[k])), (rows[k], np.arange(len(rows[k])))),
+                                                   shape=(n_g, len(rows[k])))))
+            jacobian_sums.append(ca.mtimes([selection, ca.MX(jacobian_sparsity, blocks[0][:, k]), a]))
+            hessian_sums.append(ca.mtimes([a.T, ca.MX(hessian_sparsity, blocks[1][:, k]), a]))
+    if objective is not None:
+        call, a = objective
+        _, (hessian, sparsity) = _point_nonzeros(call.function, len(call.inputs), ("objective_jac", "objective_hess"))
+        hessians.append(hessian(*_mapped_arguments([call], x, p)(X, P), lam_f))
+        hessian_places.append((sparsity, a, a))
+    jacobian_nonzeros = ca.vertcat(*jacobians) if jacobians else ca.MX(0, 1)
+    jac = _placed(jacobian_places, jacobian_nonzeros, n_g, n_x) + sum(jacobian_sums, ca.MX(n_g, n_x))
+    hess = _placed(hessian_places, ca.vertcat(*hessians), n_x, n_x, upper=True) + ca.triu(sum(hessian_sums,
+                                                                                             ca.MX(n_x, n_x)))
+    return (ca.Function("mapped_jacobian", [X, P], [jac]),
+            ca.Function("mapped_hessian", [X, P, lam_f, lam_g], [hess]))
 
 
 def _mapped_arguments(calls: list[PointCall], x: ca.SX, p: ca.SX) -> ca.Function:
@@ -159,6 +202,8 @@ def _placed(places: list[tuple[ca.Sparsity, sps.csr_matrix, sps.csr_matrix]], no
     """Σ_k L_kᵀ B_k R_k (rows × columns, its upper triangle if `upper`) for places (sparsity of B_k, L_k, R_k), the
     B_k's nonzeros stacked in `nonzeros`: P · nonzeros on the sum's sparsity, P's entries L_k[i, r] R_k[j, c] for
     each nonzero (i, j) of B_k (module docstring)."""
+    if not places:
+        return ca.MX(rows, columns)
     targets, sources, weights, offset = [], [], [], 0
     for sparsity, left, right in places:
         i, j = np.asarray(sparsity.row(), dtype=int), np.asarray(sparsity.get_col(), dtype=int)
@@ -201,6 +246,8 @@ def _chain(calls: list[tuple[PointCall, ca.SX]], x: ca.SX) -> tuple[ca.SX, list[
                 offsets[id(value)], size = size, size + value.numel()
                 unique.append(value)
             positions.append(offsets[id(value)] + np.arange(value.numel()))
+    if not calls:
+        return ca.SX(0, x.numel()), [], []
     Z = ca.vertcat(*(ca.vec(v) for v in unique))
     return ca.jacobian(Z, x)[np.concatenate(positions).tolist(), :], jacobians, hessians
 

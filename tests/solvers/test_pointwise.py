@@ -18,7 +18,9 @@ from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
 from ocpkit.geometry.scene import Boxes, Cylinders
 from ocpkit.path_spline import PathSpline
-from ocpkit.solvers.pointwise import pointwise_derivatives
+from ocpkit.nlp import Refinement
+from ocpkit.planner import screening
+from ocpkit.solvers.pointwise import _input_map, pointwise_derivatives
 from ocpkit.transcription import TRANSCRIPTIONS
 from ocpkit.transcription.ocp import PathTimingOCP
 
@@ -144,3 +146,22 @@ def test_a_callback_backend_gives_no_point_calls():
     dynamics = make_dynamics("pinocchio", CASE.robot)
     discretization = TRANSCRIPTIONS.get("chebyshev")(knots=6).build(CASE, dynamics, make_constraints(CASE))
     assert discretization.nlp.point_calls == () and discretization.nlp.objective_call is None
+
+
+def test_check_points_whose_times_are_parameters_are_mapped_too():
+    """A check point's inputs are linear in w with coefficients set by its time, an NLP parameter (refinement
+    rounds move it): its derivatives join through ∂z/∂w as a function of p, the same values as CasADi's own."""
+    problem = load_scenario(REPO / "scenarios/mbm/panda/table_pick/0001.yaml")
+    constraints = make_constraints(problem, screen=(screening.line_samples(problem), 0.05))
+    discretization = TRANSCRIPTIONS.get("chebyshev")(knots=6).build(
+        problem, make_dynamics("casadi-rnea", problem.robot), constraints)
+    nlp = discretization.nlp
+    assert sum(isinstance(_input_map(call, nlp), ca.SX) for call in nlp.point_calls) >= 8
+    ours, reference = pointwise_derivatives(nlp), _reference(nlp)
+    params = discretization.parameters(problem, Refinement(np.array([0.3, 0.55, 0.8])))
+    w = discretization.initial_guess(problem) + 0.05 * np.random.default_rng(0).standard_normal(nlp.x.numel())
+    lam = (1.3, np.random.default_rng(1).standard_normal(nlp.g.numel()))
+    jac_expected, hess_expected = (ca.densify(m).full() for m in reference(w, params, *lam))
+    np.testing.assert_allclose(ca.densify(ours["jac_g"](w, params)[1]).full(), jac_expected, rtol=1e-9, atol=1e-9)
+    hess = ca.densify(ours["hess_lag"](w, params, *lam)).full()
+    np.testing.assert_allclose(hess, hess_expected, rtol=1e-9, atol=1e-9 * np.abs(hess_expected).max())
