@@ -24,8 +24,8 @@ shot finds in time.
 
 The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an OMPL rung on a hard problem
 (MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified
-plan returns at once; the budget is what a failure costs. A ladder that verifies nothing after an OMPL rung
-found no path ends `no_path`, with the configurations that search checked: where the obstacles leave no way
+plan returns at once; the budget is what a failure costs. A ladder that verifies nothing, where every OMPL rung
+found no path, ends `no_path`, with the configurations the last search checked: where the obstacles leave no way
 through, that is the evidence, and no failed solve says more.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
@@ -198,13 +198,13 @@ def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:
 def _combined(tried: list[tuple[Rung, Plan]], skipped: list[str]) -> Plan:
     """The best plan of `tried` (rung, plan) pairs, its times and iterations summed over all of them, the rungs
     tried and the names of the `skipped` ones in its stats, and its method and message naming its rung. When none
-    verified and an OMPL rung's search found no path, that rung's `no_path` plan instead (its message: the checks
-    the search spent), with the hint NO_PATH_HINT."""
+    verified and every OMPL rung's search found no path, the last one's `no_path` plan instead (its message: the
+    checks the search spent), with the hint NO_PATH_HINT."""
     rung, best = min(tried, key=lambda pair: rank(pair[1]))
     plans = [p for _, p in tried]
-    searched = [(r, p) for r, p in tried if p.status == "no_path" and r.guess == "ompl"]
-    no_path = not best.ok and bool(searched)
-    if no_path:  # the failed search is the evidence a failed solve is not
+    searched = [(r, p) for r, p in tried if r.guess == "ompl"]
+    no_path = not best.ok and bool(searched) and all(p.status == "no_path" for _, p in searched)
+    if no_path:  # the failed searches are the evidence a failed solve is not
         rung, best = searched[-1]
     stats = dataclasses.replace(
         best.stats, solve_time=sum(p.stats.solve_time for p in plans),

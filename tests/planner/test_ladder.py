@@ -205,6 +205,9 @@ def test_a_failed_ladder_where_ompl_found_no_path_says_so():
     assert result.stats.hint == NO_PATH_HINT and result.stats.figures()["hint"] == NO_PATH_HINT
     script = Script({"a": fake("no_path"), "b": fake("verified")})
     assert climb(script, LADDER, 60.0).hint == ""
+    ompl_twice = (Rung("a"), Rung("b", guess="ompl", seed=1), Rung("c", guess="ompl", seed=2))
+    script = Script({"a": fake("infeasible"), "b": fake("violated", 0.1), "c": fake("no_path")})
+    assert climb(script, ompl_twice, 60.0).status == "violated"  # one search found a path: not blocked
 
 
 def test_an_ompl_guess_without_a_path_falls_back_to_the_papers_line_only_when_asked():
