@@ -86,6 +86,8 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options.solver}
     guess, guess_options = options.starting_guess()
     guessing = time.perf_counter()
+    if "planning_time" in guess_options:  # a path search ends by the plan's deadline, after this rung's build
+        guess_options["planning_time"] = min(guess_options["planning_time"], max(deadline - guessing, 0.0))
     try:
         w = _guess(problem, made.discretization, guess, guess_options)
     except NoGuess as exc:

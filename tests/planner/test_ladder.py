@@ -265,6 +265,19 @@ def test_a_rung_whose_guess_has_no_start_ends_no_path_before_any_solve(monkeypat
     assert plan.status == "no_path" and plan.stats.iterations == 0 and "no start here" in plan.stats.solver_message
 
 
+def test_a_path_search_ends_by_the_plans_deadline_whatever_planning_time_it_was_given(monkeypatch):
+    given = []
+
+    def searching(problem, discretization, fallback=True, planning_time=None):
+        given.append(planning_time)
+        raise NoGuess("stand-in search")
+
+    monkeypatch.setitem(GUESSES._items, "searching", searching)
+    plan_simultaneous(CASE2, knots=6, guess="searching", guess_options={"planning_time": 100.0}, max_wall_time=5.0,
+                      fallbacks=())
+    assert 0.0 < given[0] < 5.0  # what is left of 5 s after the build, not the 100 s asked for
+
+
 class Recording(Script):
     """A Script that also records the rungs it was given."""
 
