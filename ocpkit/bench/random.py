@@ -133,14 +133,16 @@ def run_random(seed: int = 1, count: int = 30, knots: int = 12, obstacles: tuple
 
 def _line(problem: Problem, result: Plan) -> str:
     """The printed line of one problem: status, t_f, time, rounds, the ladder's rung (and every rung tried, when
-    there were several), and the hint when it did not verify."""
+    there were several), and when it did not verify, what failed, the plan's message (a failed search's checks)
+    and the hint."""
     tried = result.stats.rungs
     trail = "" if len(tried) < 2 else " (tried " + ", ".join(f"{r.rung} {r.status} {r.time_s:.1f} s"
                                                             for r in tried) + ")"
     return (f"{problem.name:<10}{result.status:>16}  t_f {result.trajectory.tf:5.2f} s (bound "
             f"{problem.velocity_lower_bound():4.2f})  {result.stats.solve_time:5.2f} s  {result.stats.rounds} rounds"
             f"  rung {result.method.get('rung', '-')}{trail}"
-            + ("" if result.ok else f"  {result.verification.summary()}; hint: {result.hint}"))
+            + ("" if result.ok else f"  {result.verification.summary()}; {result.stats.solver_message}; "
+                                      f"hint: {result.hint}"))
 
 
 def _times(seconds: list[float]) -> str:
