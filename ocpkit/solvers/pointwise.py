@@ -17,16 +17,16 @@ interpolation defects, nearly linear) are differentiated by CasADi a few rows at
 when it is not a point call. The result equals CasADi's own derivatives (tests/solvers/test_pointwise.py).
 
 Calls whose inputs are linear in x (A_k constant, or a function of the parameters p alone: a check point whose
-time is a parameter) are not inlined: each distinct
-point function's derivatives are built once, evaluated over all its points by one mapped call, and joined by
-constant sparse matrices, blocks B_k placed as Σ_k L_kᵀ B_k R_k (L_k, R_k: row selections or A_k), whose
-nonzeros are P times the blocks' stacked nonzeros, P's entries L_k[i, r] R_k[j, c] per nonzero (i, j) of B_k.
-Inlining them cost most of the set-up on a large NLP (a copy of a point Hessian per point), the mapped call
-evaluates as fast. A parametric A_k(p) joins by MX products instead, Sₖ B_k A_k(p) and A_k(p)ᵀ H_k A_k(p); the
-objective, when it is a point call, joins the same way with λ_f. Calls marked `compiled` (the dynamics rows: their point function depends on the robot and the
-OCP only, so its C is the same for every problem of a robot) run their point derivatives compiled to C
-(ocpkit.solvers.compiled), CasADi's virtual machine where nothing compiles. Calls with inputs not linear in x
-(a torque with friction, a path-timing OCP's state) take the SX graph.
+time is a parameter) are not inlined: each distinct point function's derivatives are built once, evaluated over
+all its points by one mapped call, and joined by constant sparse matrices, blocks B_k placed as Σ_k L_kᵀ B_k R_k
+(L_k, R_k: row selections or A_k), whose nonzeros are P times the blocks' stacked nonzeros, P's entries
+L_k[i, r] R_k[j, c] per nonzero (i, j) of B_k. Inlining them cost most of the set-up on a large NLP (a copy of a
+point Hessian per point); the mapped call evaluates as fast. A parametric A_k(p) joins by MX products instead,
+S_k B_k A_k(p) and A_k(p)ᵀ H_k A_k(p); the objective, when it is a point call, joins the same way with λ_f. Calls
+marked `compiled` (the dynamics rows: their point function depends on the robot and the OCP only, so its C is
+the same for every problem of a robot) run their point derivatives compiled to C (ocpkit.solvers.compiled),
+CasADi's virtual machine where nothing compiles. Calls with inputs not linear in x (a torque with friction, a
+path-timing OCP's state) take the SX graph.
 """
 
 from __future__ import annotations
