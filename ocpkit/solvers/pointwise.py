@@ -120,7 +120,7 @@ def _graph_derivatives(nlp: NLP, point_calls: list[PointCall], left: np.ndarray,
 
 def _joined(nlp: NLP, graphs: dict[str, ca.Function],
             terms: tuple[ca.Function, ca.Function]) -> dict[str, ca.Function]:
-    """IPOPT's derivatives (as `pointwise_derivatives`) as MX Functions: the SX `graphs` plus the compiled `terms`."""
+    """IPOPT's derivatives (as `pointwise_derivatives`) as MX Functions: the SX `graphs` plus the mapped `terms`."""
     x, p = ca.MX.sym("x", nlp.x.numel()), ca.MX.sym("p", nlp.p.numel())
     lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", nlp.g.numel())
     g, jac = graphs["jac_g"](x, p)
