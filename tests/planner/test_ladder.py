@@ -19,8 +19,8 @@ from ocpkit.errors import NoGuess, OptionError
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
-from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, SINGLE_SHOT, Rung,
-                                   climb, finer, finer_grid, rank)
+from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_RESOLUTION,
+                                   SINGLE_SHOT, Rung, climb, finer, finer_grid, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow
@@ -117,7 +117,7 @@ def test_a_rung_overrides_only_what_it_names():
     changed = Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300).apply(options, 9.0)
     assert changed == dataclasses.replace(
         options, guess="ompl", guess_options={"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
-                                              "planning_time": 9.0}, knots=16,
+                                              "planning_time": 9.0, "resolution": OMPL_RESOLUTION}, knots=16,
         transcription_options={"staged": False, "segments": 2}, solver_options={"tol": 1e-7, "max_iterations": 300},
         iteration_budget=300)
     assert options.knots == 12 and options.solver_options == {"tol": 1e-7}
@@ -133,15 +133,18 @@ def test_a_rung_overrides_only_what_it_names():
     (DEFAULT_LADDER[0], {"solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[1], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
                          "guess_options": {"fallback": False, "seed": 0, "max_checks": OMPL_CHECKS,
-                                           "planning_time": 7.0},
+                                           "planning_time": 7.0,
+                                           "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[2], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
                          "guess_options": {"fallback": False, "seed": 1, "max_checks": OMPL_CHECKS,
-                                           "planning_time": 7.0},
+                                           "planning_time": 7.0,
+                                           "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[3], {"guess": "ompl", "knots": 16,
                          "guess_options": {"fallback": False, "seed": 2, "max_checks": OMPL_CHECKS,
-                                           "planning_time": 7.0},
+                                           "planning_time": 7.0,
+                                           "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[4], {"relaxed": True, "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[5], {})])
