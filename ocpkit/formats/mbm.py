@@ -31,6 +31,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+import yaml
 from tqdm import tqdm
 
 from ocpkit.errors import OcpkitError, RobotError
@@ -123,7 +124,7 @@ def unpack_problems(sdist: Path, robot: str, directory: Path) -> Path:
     inner = f"resources/{robot}/problems.tar.bz2"
     try:
         with tarfile.open(sdist) as outer:
-            members = {Path(*Path(m.name).parts[1:]).as_posix(): m for m in outer.getmembers() if m.isfile()}
+            members = _members(outer)
             if inner not in members or "LICENSE.txt" not in members:
                 raise DataError(f"{sdist} has no {inner} or LICENSE.txt: not a vamp-planner sdist?")
             (directory / "LICENSE-vamp.txt").write_bytes(outer.extractfile(members["LICENSE.txt"]).read())
@@ -134,6 +135,11 @@ def unpack_problems(sdist: Path, robot: str, directory: Path) -> Path:
                         "again)") from exc
     done.touch()
     return moveit / "problems"
+
+
+def _members(sdist: tarfile.TarFile) -> dict[str, tarfile.TarInfo]:
+    """The sdist's regular files by their path below its top folder (resources/..., LICENSE.txt)."""
+    return {Path(*Path(m.name).parts[1:]).as_posix(): m for m in sdist.getmembers() if m.isfile()}
 
 
 def _built_in(robot: str) -> bool:
@@ -155,7 +161,7 @@ def import_robot(sdist: Path, robot: str, folder: Path) -> Path:
     names = (f"{robot}.urdf", f"{robot}.srdf", f"{robot}_spherized.urdf")
     try:
         with tarfile.open(sdist) as outer:
-            members = {Path(*Path(m.name).parts[1:]).as_posix(): m for m in outer.getmembers() if m.isfile()}
+            members = _members(outer)
             missing = [n for n in names if f"resources/{robot}/{n}" not in members]
             if missing:
                 raise DataError(f"{sdist} has no resources/{robot}/{missing[0]}: not a vamp-planner sdist?")
@@ -195,25 +201,25 @@ def convert_problems(robot: str, problems: Path, out: Path, progress: bool = Tru
         raise DataError(f"no MBM problems under {problems}")
     written = kept = 0
     rejected: list[str] = []
-    entries: dict[str, tuple] = {}  # per scene folder: resolve_robot's answer, the spec's path relative to it
+    entries: dict[str, tuple] = {}  # per scene folder: resolve_robot's answer (a spec path is relative to it)
     for scene, request in tqdm(pairs, desc=f"MBM {robot}", unit="problem", disable=not progress):
         if scene not in entries:
             entries[scene] = _robot_entry(robot, spec, out / scene)
         field, joints, loaded = entries[scene]
         number = request.stem.removeprefix("request")
         target = out / scene / f"{number}.yaml"
-        text = None
-        if not _names(target, field):
+        if _names(target, field):
+            kept += 1
+        else:
             conversion = read_moveit(request.with_name(f"scene{number}.yaml"), request, joints, field,
                                      f"{scene}_{number}")
             source = f"{robot}/moveit/problems/{scene}_{robot}/{{scene,request}}{number}.yaml"
             notice = [line.format(version=VAMP_VERSION, robot=robot) for line in NOTICE]
-            text = scenario_text(conversion, [*notice, f"Source: {source}"])
             target.parent.mkdir(parents=True, exist_ok=True)
             partial = target.with_suffix(".part")  # renamed when complete: an interrupted run leaves no half file
-            partial.write_text(text)
+            partial.write_text(scenario_text(conversion, [*notice, f"Source: {source}"]))
             partial.replace(target)
-        written, kept = written + (text is not None), kept + (text is None)
+            written += 1
         if loaded is not None:
             try:
                 load_scenario(target)
@@ -236,8 +242,8 @@ def _robot_entry(robot: str, spec: Path | None, folder: Path) -> tuple:
 
 
 def _names(target: Path, field: str | dict) -> bool:
-    """Whether the scenario file `target` exists and names the robot entry `field` (a conversion to keep)."""
+    """Whether the scenario file `target` exists and its `robot:` line is the entry `field` (a conversion to keep)."""
     if not target.is_file():
         return False
-    entry = field if isinstance(field, str) else "{" + ", ".join(f"{k}: {v}" for k, v in field.items()) + "}"
-    return f"\nrobot: {entry}\n" in target.read_text()
+    line = next((line for line in target.read_text().splitlines() if line.startswith("robot:")), "robot:")
+    return yaml.safe_load(line)["robot"] == field

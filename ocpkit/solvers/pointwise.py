@@ -134,9 +134,9 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
                   objective: tuple[PointCall, sps.csr_matrix] | None,
                   compile: bool) -> tuple[ca.Function, ca.Function]:
     """MX Functions (x, p → the `mapped` calls' rows of ∂g/∂x; x, p, λ_f, λ_g → their part, and the `objective`
-    call's, of the Hessian's upper triangle) for calls with constant input maps A (module docstring): one point
-    function's derivatives mapped over all its calls, compiled where every call is marked `compiled` (and
-    `compile`), else run by CasADi's virtual machine."""
+    call's, of the Hessian's upper triangle) for calls whose input maps A are constant or functions of p (module
+    docstring): one point function's derivatives mapped over all its calls, compiled where every call is marked
+    `compiled` (and `compile`), else run by CasADi's virtual machine."""
     x, p, n_x, n_g = nlp.x, nlp.p, nlp.x.numel(), nlp.g.numel()
     X, P = ca.MX.sym("x", n_x), ca.MX.sym("p", nlp.p.numel())
     lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", n_g)
@@ -167,7 +167,7 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
                                        shape=(len(rows[k]), n_g))
             jacobian_places.append((jacobian_sparsity, selection, calls[k][1]))
             hessian_places.append((hessian_sparsity, calls[k][1], calls[k][1]))
-        parametric = [k for k in range(len(calls)) if k not in constant]
+        parametric = [k for k, (_, a) in enumerate(calls) if not isinstance(a, sps.csr_matrix)]
         maps = ca.Function("input_maps", [p], [calls[k][1] for k in parametric]).call([P]) if parametric else []
         for k, a in zip(parametric, maps):
             selection = ca.MX(ca.DM(sps.csc_matrix((np.ones(len(rows[k])), (rows[k], np.arange(len(rows[k])))),
