@@ -105,6 +105,13 @@ class Clearances:
         return min([np.inf] + [float(v.min()) for v in (self.self_pairs, self.obstacles, self.workspace) if v.size])
 
 
+def buried(robot: Robot, scene: Scene, centers: np.ndarray) -> np.ndarray:
+    """Per configuration (K,): whether some sphere centre of `centers` (K, M, 3) lies inside an obstacle (inside a
+    box or a cylinder, its collision row has no gradient: ocpkit.constraints.collision)."""
+    inside = clearances(robot, scene, centers).obstacles + robot.sphere_radius[None, :, None]
+    return (inside <= 0).any(axis=(1, 2))
+
+
 def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:
     """Clearances of sphere centres (K, M, 3) against each other, the obstacles and the workspace box."""
     r = robot.sphere_radius

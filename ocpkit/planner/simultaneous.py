@@ -21,7 +21,8 @@ from ocpkit.formats.trajectory import Trajectory
 from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, screening
 from ocpkit.planner.build_cache import Build, build, construct
-from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb
+from ocpkit.geometry.clearances import buried, sphere_centers_batch
+from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb, ordered
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.problem import Problem
@@ -30,6 +31,7 @@ from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization
 
 END_CHECK_CLEARANCE = 0.05  # m: a start or goal this close to contact gets checks in every knot interval
+STRAIGHT_LINE_GUESSES = ("paper", "line")  # the guess rules that start from the straight joint-space line
 
 
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
@@ -54,7 +56,8 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     computation (guess, every solve and refinement round, every rung): each solve gets the time left (a solver that
     cannot be interrupted, blocksqp or fatrop, can overrun it by one solve), and the plan ends as `time_limit` when
     it runs out. `fallbacks` is the ladder of rungs (ocpkit.planner.ladder), each overriding these options
-    (Rung.apply), tried in order until one plan verifies; () plans once with these options (SINGLE_SHOT, the
+    (Rung.apply), tried in order until one plan verifies (the first OMPL rung first when the straight line is
+    buried in obstacles: ocpkit.planner.ladder.ordered); () plans once with these options (SINGLE_SHOT, the
     paper's setting). `screen`: whether the NLP carries only the collision rows near the motion
     (ocpkit.planner.screening; None: whenever the robot and scene have collision terms). The options travel as one
     ocpkit.planner.options.SimultaneousOptions."""
@@ -67,7 +70,16 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     def attempt(rung: Rung | None, left: float) -> Plan:
         return _single_shot(problem, options if rung is None else rung.apply(options, left), left)
 
-    return climb(attempt, options.fallbacks, options.max_wall_time)
+    return climb(attempt, ordered(options.fallbacks, _buried_line(problem, options)), options.max_wall_time)
+
+
+def _buried_line(problem: Problem, options: SimultaneousOptions) -> float:
+    """The fraction of the straight line's samples (ocpkit.planner.screening.line_samples) with a sphere centre
+    inside an obstacle when the call's guess starts from that line; 0 otherwise."""
+    if not (isinstance(options.guess, str) and options.guess in STRAIGHT_LINE_GUESSES):
+        return 0.0
+    centers = sphere_centers_batch(problem.robot, screening.line_samples(problem))
+    return float(buried(problem.robot, problem.scene, centers).mean())
 
 
 def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: float) -> Plan:

@@ -11,7 +11,7 @@ import yaml
 
 import ocpkit
 import ocpkit.geometry.clearances
-from ocpkit.geometry.clearances import Clearances, clearances, collision_report, sphere_centers
+from ocpkit.geometry.clearances import Clearances, buried, clearances, collision_report, sphere_centers
 from ocpkit.geometry.scene import Scene, Workspace
 from ocpkit.robots.robot import DATA_DIR
 
@@ -89,6 +89,14 @@ def test_workspace_clearances_are_face_distance_minus_radius():
     expected = np.stack([x + 1, np.full(M, 2.0), np.full(M, 3.0), 200 - x, np.full(M, 4.0), np.full(M, 5.0)], axis=1)
     np.testing.assert_allclose(c.workspace[0], expected - RADIUS[:, None])
     assert c.smallest() == pytest.approx(1.0 - RADIUS[0])  # sphere 0, 1 m from x min
+
+
+def test_a_configuration_is_buried_when_some_sphere_centre_lies_inside_an_obstacle():
+    centers = np.concatenate([line_of_spheres(), line_of_spheres() + [0.0, 9.0, 0.0]])  # (2, M, 3)
+    reach = 3.0 + RADIUS[2]  # touching sphere 2 (at x = 20) but not enclosing its centre ...
+    assert not buried(ROBOT, Scene(np.array([[20.0, reach - 1e-3, 0.0]]), np.array([3.0])), centers[:1])[0]
+    inside = Scene(np.array([[20.0, 2.0, 0.0]]), np.array([3.0]))  # ... and 2 m from it: the centre is inside
+    assert buried(ROBOT, inside, centers).tolist() == [True, False]  # the second row is 7 m away
 
 
 def test_without_a_workspace_there_are_no_face_clearances():
