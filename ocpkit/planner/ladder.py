@@ -24,10 +24,10 @@ continuation rung solves the problem relaxed first (a softened margin, wider lim
 The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
 shot finds in time.
 
-A straight line that runs with some sphere centre inside an obstacle over BURIED_LINE of its length or more starts
-the capped first rung where its collision rows are flat (no gradient inside a box or a cylinder): IPOPT then
-mostly spends the rung's iterations and ends infeasible or at its cap. For such a problem `ordered` moves the
-rungs that start from the line after the first OMPL rung, whose path starts clear of the obstacles.
+A straight line that runs with some sphere centre inside an obstacle starts the capped first rung where some of
+its collision rows are flat (no gradient inside a box or a cylinder): IPOPT then often spends the rung's
+iterations and ends infeasible or at its cap. For such a problem `ordered` moves the rungs that start from the
+line after the first OMPL rung, whose path starts clear of the obstacles.
 
 The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an OMPL rung on a hard problem
 (MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified
@@ -61,7 +61,6 @@ MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
 MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
-BURIED_LINE = 1 / 3  # of the straight line's length with a sphere centre inside an obstacle: the OMPL rung first
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 
 
@@ -148,12 +147,12 @@ STATUS_ORDER = ("verified", "violated", "infeasible", "iteration_limit", "time_l
 """Plan statuses from best to worst, for `rank`."""
 
 
-def ordered(ladder: Sequence[Rung], buried: float) -> tuple[Rung, ...]:
-    """`ladder` for a problem whose straight line has a sphere centre inside an obstacle over the fraction
-    `buried` of its length: as it is below BURIED_LINE, else with the rungs before the first OMPL rung that start
-    from the call's guess (`guess` None, not relaxed) moved after that rung (module docstring)."""
+def ordered(ladder: Sequence[Rung], line_buried: bool) -> tuple[Rung, ...]:
+    """`ladder` as it is, or, when the straight line has a sphere centre inside an obstacle somewhere
+    (`line_buried`), with the rungs before the first OMPL rung that start from the call's guess (`guess` None, not
+    relaxed) moved after that rung (module docstring)."""
     first = next((k for k, rung in enumerate(ladder) if rung.guess == "ompl"), None)
-    if buried < BURIED_LINE or first is None:
+    if not line_buried or first is None:
         return tuple(ladder)
     moved = [rung for rung in ladder[:first] if rung.guess is None and not rung.relaxed]
     kept = [rung for rung in ladder[:first] if rung not in moved]

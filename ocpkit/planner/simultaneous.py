@@ -73,13 +73,13 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
     return climb(attempt, ordered(options.fallbacks, _buried_line(problem, options)), options.max_wall_time)
 
 
-def _buried_line(problem: Problem, options: SimultaneousOptions) -> float:
-    """The fraction of the straight line's samples (ocpkit.planner.screening.line_samples) with a sphere centre
-    inside an obstacle when the call's guess starts from that line; 0 otherwise."""
+def _buried_line(problem: Problem, options: SimultaneousOptions) -> bool:
+    """Whether the call's guess starts from the straight line and some sample of that line
+    (ocpkit.planner.screening.line_samples) has a sphere centre inside an obstacle."""
     if not (isinstance(options.guess, str) and options.guess in STRAIGHT_LINE_GUESSES):
-        return 0.0
+        return False
     centers = sphere_centers_batch(problem.robot, screening.line_samples(problem))
-    return float(buried(problem.robot, problem.scene, centers).mean())
+    return bool(buried(problem.robot, problem.scene, centers).any())
 
 
 def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: float) -> Plan:

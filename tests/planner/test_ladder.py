@@ -21,7 +21,7 @@ from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
 from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_RESOLUTION,
-                                   BURIED_LINE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
+                                   SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow
@@ -185,13 +185,13 @@ def test_the_default_ladder_starts_with_the_calls_guess_and_ends_uncapped():
 def test_a_buried_line_moves_the_rungs_that_start_from_it_after_the_first_ompl_rung():
     relaxed = Rung("relaxed", relaxed=True)
     ladder = (Rung("a"), relaxed, Rung("b", guess="ompl", seed=1), Rung("c", knots=16))
-    assert ordered(ladder, BURIED_LINE - 0.01) == ladder
-    assert [r.name for r in ordered(ladder, BURIED_LINE)] == ["relaxed", "b", "a", "c"]
-    assert ordered(ladder[:2], 1.0) == ladder[:2]  # no OMPL rung: nothing to move
-    assert [r.name for r in ordered(DEFAULT_LADDER, 1.0)][:2] == [DEFAULT_LADDER[1].name, DEFAULT_LADDER[0].name]
+    assert ordered(ladder, False) == ladder
+    assert [r.name for r in ordered(ladder, True)] == ["relaxed", "b", "a", "c"]
+    assert ordered(ladder[:2], True) == ladder[:2]  # no OMPL rung: nothing to move
+    assert [r.name for r in ordered(DEFAULT_LADDER, True)][:2] == [DEFAULT_LADDER[1].name, DEFAULT_LADDER[0].name]
 
 
-def test_a_straight_line_through_an_obstacle_plans_the_ompl_rung_first(monkeypatch):
+def test_a_straight_line_with_a_sphere_centre_inside_an_obstacle_plans_the_ompl_rung_first(monkeypatch):
     base = sphere_centers(CASE2.robot, CASE2.start)[CASE2.robot.sphere_joint == 0][:1]  # a sphere that never moves
     blocked = dataclasses.replace(CASE2, scene=dataclasses.replace(CASE2.scene, obstacle_centers=base,
                                                                    obstacle_radii=np.array([0.01])))
@@ -199,7 +199,8 @@ def test_a_straight_line_through_an_obstacle_plans_the_ompl_rung_first(monkeypat
     monkeypatch.setattr("ocpkit.planner.simultaneous.climb", lambda attempt, ladder, budget: seen.append(ladder))
     plan_simultaneous(blocked, knots=6)
     plan_simultaneous(blocked, knots=6, guess="ompl")  # a guess of its own: the ladder as given
-    assert seen[0][0].guess == "ompl" and seen[1] == DEFAULT_LADDER
+    plan_simultaneous(CASE2, knots=6)  # its line is clear
+    assert seen[0][0].guess == "ompl" and seen[1] == DEFAULT_LADDER and seen[2] == DEFAULT_LADDER
 
 
 def test_a_plan_that_verifies_on_the_first_rung_reports_one_rung():
