@@ -106,10 +106,11 @@ class Clearances:
 
 
 def buried(robot: Robot, scene: Scene, centers: np.ndarray) -> np.ndarray:
-    """Per configuration (K,): whether some sphere centre of `centers` (K, M, 3) lies inside an obstacle (inside a
-    box or a cylinder, its collision row has no gradient: ocpkit.constraints.collision)."""
-    inside = clearances(robot, scene, centers).obstacles + robot.sphere_radius[None, :, None]
-    return (inside <= 0).any(axis=(1, 2))
+    """Per configuration (K,): whether some sphere centre of `centers` (K, M, 3) lies inside an obstacle box or
+    cylinder, where its collision row has no gradient (ocpkit.constraints.collision; a sphere obstacle's row has
+    one everywhere but at its centre)."""
+    solids = clearances(robot, scene, centers).obstacles[..., len(scene.obstacle_radii):]
+    return (solids + robot.sphere_radius[None, :, None] <= 0).any(axis=(1, 2))
 
 
 def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:

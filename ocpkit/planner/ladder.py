@@ -24,8 +24,8 @@ continuation rung solves the problem relaxed first (a softened margin, wider lim
 The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
 shot finds in time.
 
-A straight line that runs with some sphere centre inside an obstacle starts the capped first rung where some of
-its collision rows are flat (no gradient inside a box or a cylinder): IPOPT then often spends the rung's
+A straight line that runs with some sphere centre inside an obstacle box or cylinder starts the capped first rung
+where some of its collision rows are flat (no gradient there): IPOPT then often spends the rung's
 iterations and ends infeasible or at its cap. For such a problem `ordered` moves the rungs that start from the
 line after the first OMPL rung, whose path starts clear of the obstacles.
 
@@ -148,7 +148,7 @@ STATUS_ORDER = ("verified", "violated", "infeasible", "iteration_limit", "time_l
 
 
 def ordered(ladder: Sequence[Rung], line_buried: bool) -> tuple[Rung, ...]:
-    """`ladder` as it is, or, when the straight line has a sphere centre inside an obstacle somewhere
+    """`ladder` as it is, or, when the straight line has a sphere centre inside an obstacle box or cylinder somewhere
     (`line_buried`), with the rungs before the first OMPL rung that start from the call's guess (`guess` None, not
     relaxed) moved after that rung (module docstring)."""
     first = next((k for k, rung in enumerate(ladder) if rung.guess == "ompl"), None)

@@ -75,7 +75,7 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
 
 def _buried_line(problem: Problem, options: SimultaneousOptions) -> bool:
     """Whether the call's guess starts from the straight line and some sample of that line
-    (ocpkit.planner.screening.line_samples) has a sphere centre inside an obstacle."""
+    (ocpkit.planner.screening.line_samples) has a sphere centre inside an obstacle box or cylinder."""
     if not (isinstance(options.guess, str) and options.guess in STRAIGHT_LINE_GUESSES):
         return False
     centers = sphere_centers_batch(problem.robot, screening.line_samples(problem))

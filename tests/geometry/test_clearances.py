@@ -12,7 +12,7 @@ import yaml
 import ocpkit
 import ocpkit.geometry.clearances
 from ocpkit.geometry.clearances import Clearances, buried, clearances, collision_report, sphere_centers
-from ocpkit.geometry.scene import Scene, Workspace
+from ocpkit.geometry.scene import Boxes, Scene, Workspace
 from ocpkit.robots.robot import DATA_DIR
 
 ROBOT = ocpkit.load_robot("industrial6")
@@ -91,12 +91,16 @@ def test_workspace_clearances_are_face_distance_minus_radius():
     assert c.smallest() == pytest.approx(1.0 - RADIUS[0])  # sphere 0, 1 m from x min
 
 
-def test_a_configuration_is_buried_when_some_sphere_centre_lies_inside_an_obstacle():
+def test_a_configuration_is_buried_when_some_sphere_centre_lies_inside_an_obstacle_box():
     centers = np.concatenate([line_of_spheres(), line_of_spheres() + [0.0, 9.0, 0.0]])  # (2, M, 3)
-    reach = 3.0 + RADIUS[2]  # touching sphere 2 (at x = 20) but not enclosing its centre ...
-    assert not buried(ROBOT, Scene(np.array([[20.0, reach - 1e-3, 0.0]]), np.array([3.0])), centers[:1])[0]
-    inside = Scene(np.array([[20.0, 2.0, 0.0]]), np.array([3.0]))  # ... and 2 m from it: the centre is inside
-    assert buried(ROBOT, inside, centers).tolist() == [True, False]  # the second row is 7 m away
+
+    def box(y: float) -> Boxes:  # a 6 m cube at (20, y, 0): around sphere 2 of the first row when |y| < 3
+        return Boxes(np.array([[20.0, y, 0.0]]), np.full((1, 3), 6.0), np.eye(3)[None])
+
+    assert buried(ROBOT, Scene(boxes=box(2.0)), centers).tolist() == [True, False]  # the second row is 7 m away
+    assert not buried(ROBOT, Scene(boxes=box(3.0 + 1e-3)), centers[:1])[0]  # touching sphere 2, not its centre
+    around = Scene(np.array([[20.0, 0.0, 0.0]]), np.array([3.0]))  # a sphere obstacle's row keeps its gradient
+    assert not buried(ROBOT, around, centers[:1])[0]
 
 
 def test_without_a_workspace_there_are_no_face_clearances():

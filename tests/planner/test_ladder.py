@@ -18,6 +18,7 @@ from ocpkit.cli.main import _planner_options, parser
 from ocpkit.errors import NoGuess, OptionError
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.geometry.clearances import sphere_centers
+from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
 from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_RESOLUTION,
@@ -193,8 +194,8 @@ def test_a_buried_line_moves_the_rungs_that_start_from_it_after_the_first_ompl_r
 
 def test_a_straight_line_with_a_sphere_centre_inside_an_obstacle_plans_the_ompl_rung_first(monkeypatch):
     base = sphere_centers(CASE2.robot, CASE2.start)[CASE2.robot.sphere_joint == 0][:1]  # a sphere that never moves
-    blocked = dataclasses.replace(CASE2, scene=dataclasses.replace(CASE2.scene, obstacle_centers=base,
-                                                                   obstacle_radii=np.array([0.01])))
+    box = Boxes(base, np.full((1, 3), 0.02), np.eye(3)[None])
+    blocked = dataclasses.replace(CASE2, scene=dataclasses.replace(CASE2.scene, boxes=box))
     seen = []
     monkeypatch.setattr("ocpkit.planner.simultaneous.climb", lambda attempt, ladder, budget: seen.append(ladder))
     plan_simultaneous(blocked, knots=6)
