@@ -15,6 +15,7 @@ the shipped MBM problems and no more of the hard random suite.
 from __future__ import annotations
 
 import dataclasses
+import time
 from typing import Any
 
 import numpy as np
@@ -91,9 +92,12 @@ def ompl_guess(problem: Problem, discretization: Discretization, fallback: bool 
     slowed to `slowdown` times its time, sampled on the discretization's grid by `encode`. Slowed, because
     TOPP-RA's time-optimal timing rides the velocity and torque limits with bang-bang accelerations, leaving no
     room for the torque-rate limits and the jerk cost the NLP must meet. Without a seed motion: the paper's
-    straight line (the default) with `fallback`, else NoGuess."""
+    straight line (the default) with `fallback`, else NoGuess. A `planning_time` bounds the whole seed, its
+    validity checker's construction included (SeedOptions.deadline): the guess is part of the plan's budget."""
     if not slowdown >= 1.0:
         raise OptionError(f"slowdown must be at least 1, got {slowdown!r}")
+    if "planning_time" in seed_options and "deadline" not in seed_options:
+        seed_options["deadline"] = time.perf_counter() + seed_options["planning_time"]
     seeded = ompl_seed(problem, SeedOptions(**seed_options))
     if seeded.trajectory is None:
         if fallback:

@@ -395,7 +395,9 @@ class SeedOptions:
     clearance if that is smaller (`planning_space`). `max_checks`: OMPL stops after checking this many
     configurations too (a budget that repeats on any machine; planning_time may then be inf; only for the
     planners that plan in the calling thread, not PRM). `max_step` (rad): the longest extension of RRTConnect
-    and RRT* (OMPL's `range`; BIT* and PRM have none); None: OMPL's."""
+    and RRT* (OMPL's `range`; BIT* and PRM have none); None: OMPL's. `deadline` (a time.perf_counter() value):
+    the search also ends then, whatever `planning_time` is left: a planner's budget, which counts the validity
+    checker's construction (a second or more on a robot with thousands of sphere pairs) too."""
 
     planner_name: str = "rrtconnect"
     planning_time: float = 1.0
@@ -405,6 +407,13 @@ class SeedOptions:
     margin: float = 0.01
     max_checks: int | None = None
     max_step: float | None = MAX_STEP
+    deadline: float | None = None
+
+    def search_time(self) -> float:
+        """The search's time budget (s) from now: `planning_time`, cut to what is left before `deadline`."""
+        if self.deadline is None:
+            return self.planning_time
+        return min(self.planning_time, max(self.deadline - time.perf_counter(), 0.0))
 
 
 @dataclass(frozen=True)
@@ -431,11 +440,12 @@ def ompl_seed(problem: Problem, options: SeedOptions = SeedOptions()) -> Seed:
         return Seed(hold(problem), None, "the goal is the start: hold still")
     setup = import_backends()
     free = planning_space(problem, options.margin)
-    found = ompl_path(problem, free, options.planner_name, options.planning_time, options.seed, options.resolution,
+    planning_time = options.search_time()
+    found = ompl_path(problem, free, options.planner_name, planning_time, options.seed, options.resolution,
                       options.max_checks, options.max_step)
     searched = Timing(path_search=found.path_time, simplify=found.simplify_time, smooth=0.0, path_timing=0.0)
     if found.waypoints is None:
-        return Seed(None, "no_path", no_path_message(options.planner_name, options.planning_time, free), setup,
+        return Seed(None, "no_path", no_path_message(options.planner_name, planning_time, free), setup,
                     searched, PathStats(free.checks, 0, 0, free.margin))
     smoothing = time.perf_counter()
     path, rounds = smooth_path(found.waypoints, free, options.resolution)

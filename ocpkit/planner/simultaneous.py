@@ -18,10 +18,10 @@ from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics
 from ocpkit.errors import NoGuess, OptionError
 from ocpkit.formats.trajectory import Trajectory
+from ocpkit.geometry.clearances import buried, sphere_centers_batch
 from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, screening
 from ocpkit.planner.build_cache import Build, build, construct
-from ocpkit.geometry.clearances import buried, sphere_centers_batch
 from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb, ordered
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import time
 
 import numpy as np
 import pinocchio as pin
@@ -15,6 +16,7 @@ import ocpkit
 from ocpkit.baselines.ompl_toppra import plan_ompl_toppra
 from ocpkit.errors import OptionError
 from ocpkit.planner.guesses import GUESS_SLOWDOWN, ompl_guess
+from ocpkit.planner import ompl_seed as ompl_seed_module
 from ocpkit.planner.ompl_seed import PathMotion, SeedOptions, ompl_seed, slowed
 
 
@@ -56,6 +58,25 @@ def test_without_a_path_the_seed_has_no_motion_and_says_why(case1, no_verify):
     seed = ompl_seed(case1, SeedOptions(planning_time=0.0))
     assert seed.trajectory is None and seed.stopped == "no_path" and "no exact path" in seed.message
     assert seed.path.waypoints == 0 and seed.timing.smooth == 0.0
+
+
+def test_the_guess_counts_its_checkers_construction_against_its_planning_time(case1, monkeypatch):
+    build, searched = ompl_seed_module.planning_space, []
+
+    def slow_build(problem, margin):
+        time.sleep(0.3)
+        return build(problem, margin)
+
+    def search(problem, free, planner_name, planning_time, *args):
+        searched.append(planning_time)
+        return ompl_seed_module.OmplPath(None, 0.0, 0.0)
+
+    monkeypatch.setattr(ompl_seed_module, "planning_space", slow_build)
+    monkeypatch.setattr(ompl_seed_module, "ompl_path", search)
+    nlp = discretize(case1, "chebyshev", "casadi-rnea", knots=6)
+    ompl_guess(case1, nlp, planning_time=1.0)
+    ompl_seed(case1, SeedOptions(planning_time=1.0))  # the baselines' search: planning_time is OMPL's own
+    assert searched[0] <= 0.7 and searched[1] == 1.0
 
 
 def test_an_option_the_seed_does_not_take_is_refused_by_the_planner(case1):
