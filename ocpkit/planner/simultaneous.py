@@ -23,6 +23,7 @@ from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, screening
 from ocpkit.planner.build_cache import Build, build, construct
 from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb, ordered
+from ocpkit.planner.ompl_seed import hold
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.problem import Problem
@@ -85,9 +86,10 @@ def _buried_line(problem: Problem, options: SimultaneousOptions) -> bool:
 def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: float) -> Plan:
     """One plan with `options`: build, guess, solve with refinement rounds, all within `max_wall_time` (s) of
     computation and set-up. A guess rule with no start to offer (NoGuess) ends the plan as `no_path` before any
-    solve. With screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight
-    line; a guess or an unverified solution that comes near rows left out is solved again on a rebuild with them
-    added."""
+    solve, holding the start (a dense check of a placeholder motion would only spend the budget: seconds on a
+    robot with thousands of sphere pairs). With screening (ocpkit.planner.screening) the first build keeps the
+    collision rows near the straight line; a guess or an unverified solution that comes near rows left out is
+    solved again on a rebuild with them added."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
     options = _checked_near_the_ends(problem, options)
@@ -102,10 +104,9 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
         guess_options["planning_time"] = min(guess_options["planning_time"], max(deadline - guessing, 0.0))
     try:
         w = _guess(problem, made.discretization, guess, guess_options)
-    except NoGuess as exc:
-        line = made.discretization.decode(made.discretization.initial_guess(problem))
-        return finish(problem, line, "no_path", method, started, setup_time=made.setup_time,
-                      message=f"guess {guess!r}: {exc}; not solved")
+    except NoGuess as exc:  # no motion to report: the robot holds its start (the baselines' no_path plan too),
+        return finish(problem, hold(problem), "no_path", method, started, setup_time=made.setup_time,
+                      message=f"guess {guess!r}: {exc}; not solved, the plan holds the start")
     guess_time = time.perf_counter() - guessing
     first_setup = made.setup_time
     if near is not None and (wider := _widened(problem, options, made, near, made.discretization.decode(w))):

@@ -289,6 +289,7 @@ def test_a_rung_whose_guess_has_no_start_ends_no_path_before_any_solve(monkeypat
     monkeypatch.setitem(GUESSES._items, "nothing", nothing)
     plan = plan_simultaneous(CASE2, knots=6, fallbacks=(Rung("n", guess="nothing"),))
     assert plan.status == "no_path" and plan.stats.iterations == 0 and "no start here" in plan.stats.solver_message
+    assert np.all(plan.trajectory.knots.q == CASE2.start) and plan.trajectory.tf == CASE2.time.min  # holds the start
 
 
 def test_a_path_search_ends_by_the_plans_deadline_whatever_planning_time_it_was_given(monkeypatch):
