@@ -104,7 +104,7 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
         guess_options["planning_time"] = min(guess_options["planning_time"], max(deadline - guessing, 0.0))
     try:
         w = _guess(problem, made.discretization, guess, guess_options)
-    except NoGuess as exc:  # no motion to report: the robot holds its start (the baselines' no_path plan too),
+    except NoGuess as exc:  # no motion to report: the robot holds its start, as in the baselines' no_path plans
         return finish(problem, hold(problem), "no_path", method, started, setup_time=made.setup_time,
                       message=f"guess {guess!r}: {exc}; not solved, the plan holds the start")
     guess_time = time.perf_counter() - guessing
