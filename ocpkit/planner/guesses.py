@@ -27,6 +27,8 @@ from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
 from ocpkit.transcription import Discretization
 
+STRAIGHT_LINE_RULES = ("paper", "line")
+"""The registered names of the rules here that start from the straight joint-space line."""
 PEAK_SPEED = 1.875
 """Peak of ds/dτ of the quintic rest-to-rest profile s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ (τ = t / t_f)."""
 TORQUE_SAMPLES = 21

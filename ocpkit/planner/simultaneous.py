@@ -22,6 +22,7 @@ from ocpkit.geometry.clearances import buried, sphere_centers_batch
 from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, screening
 from ocpkit.planner.build_cache import Build, build, construct
+from ocpkit.planner.guesses import STRAIGHT_LINE_RULES
 from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb, ordered
 from ocpkit.planner.ompl_seed import hold
 from ocpkit.planner.options import SimultaneousOptions
@@ -32,7 +33,6 @@ from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization
 
 END_CHECK_CLEARANCE = 0.05  # m: a start or goal this close to contact gets checks in every knot interval
-STRAIGHT_LINE_GUESSES = ("paper", "line")  # the guess rules that start from the straight joint-space line
 
 
 def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
@@ -77,7 +77,7 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
 def _buried_line(problem: Problem, options: SimultaneousOptions) -> bool:
     """Whether the call's guess starts from the straight line and some sample of that line
     (ocpkit.planner.screening.line_samples) has a sphere centre inside an obstacle box or cylinder."""
-    if not (isinstance(options.guess, str) and options.guess in STRAIGHT_LINE_GUESSES):
+    if not (isinstance(options.guess, str) and options.guess in STRAIGHT_LINE_RULES):
         return False
     centers = sphere_centers_batch(problem.robot, screening.line_samples(problem))
     return bool(buried(problem.robot, problem.scene, centers).any())
