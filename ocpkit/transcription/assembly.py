@@ -5,21 +5,21 @@ w) and adds its rows in the order it wants them; the assembly supplies the rest 
 against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP unless told otherwise):
 
 - the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, the OCP's, ...];
-- the nodes [x, ẋ, ẍ, u] (the OCP's chain and the scaled rigid-body torque u);
-- the values at a point, `point(node, slope, dt_ds)`: the robot's (q, q̇, q̈) = ocp.robot_state(node), joint
-  torque τ and its rate dτ/ds as the OCP gives them (`OCP.torque`; for the robot OCP τ = τ_max ∘ u +
-  friction(q̇) and dτ/ds = τ_max du/ds + friction'(q̇) (dt/ds) q̈) from the interpolant's slopes du/ds and
-  dẍ/ds (`Slope`), where dt/ds is the transcription's (t_f/(2K) on a pseudospectral segment, h = t_f/N on a
-  mesh interval), so rate bounds read |dτ/ds| ≤ (dt/ds) τ̇_max and t_f never divides;
+- the nodes [x, u] (the OCP's states and controls) and the OCP's own variables (`OCP.declare`);
+- the values at a point, `point(node, du_ds, dt_ds)`, as the OCP gives them for its path constraints
+  (`OCP.point_values`; for a robot: (q, q̇, q̈), the joint torque and its rate dτ/dσ) from the interpolant's
+  slope du/dσ, where dt/dσ is the transcription's (t_f/(2K) on a pseudospectral segment, h = t_f/N on a mesh
+  interval), so rate bounds read |dτ/dσ| ≤ (dt/dσ) τ̇_max and t_f never divides;
 - the path constraints at a point (`path`, `rates`), each constraint imposed as it declares (constraints.base),
   through one CasADi Function per constraint of a symbolic point, made once and inlined at every point (running a
   constraint's Python code point by point makes graph construction slow);
-- the OCP's rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) = 0), also
-  through one Function of a symbolic node where the dynamics backend is symbolic (exact second derivatives);
+- the OCP's algebraic rows at a collocation point (for the robot OCP the dynamics residual(q, q̇, q̈, τ_max u) =
+  0), also through one Function of a symbolic node where the dynamics backend is symbolic (exact second
+  derivatives);
 - a record of those point Functions' rows (`NLP.point_calls`), from which IPOPT's derivatives are built point by
   point (ocpkit.solvers.pointwise);
-- the robot's jerk times dt/ds at a point (`jerk_s`), which the jerk cost integrates; the objective, through a
-  Function of its inputs where the transcription gives it so (`objective`);
+- the OCP's running-cost inputs at a point (`running`); the objective, through a Function of its inputs where the
+  transcription gives it so (`objective`);
 - the rows lbg ≤ g ≤ ubg in the order they were added, and the finished `NLP`.
 """
 
@@ -35,19 +35,20 @@ from ocpkit.constraints import Constraint, Context, PointValues, Rows
 from ocpkit.dynamics import Dynamics
 from ocpkit.nlp import NLP, Layout, PointCall, Stages
 from ocpkit.problem import Problem
-from ocpkit.transcription.ocp import OCP, Node, RobotOCP, Slope
+from ocpkit.transcription.ocp import OCP, Node, RobotOCP
 
-__all__ = ["Assembly", "Node", "Slope"]
+__all__ = ["Assembly", "Node"]
 
 
 class Assembly:
     """The variables, parameters and rows of one NLP under construction (see the module docstring)."""
 
-    def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
+    def __init__(self, problem: Problem | None, dynamics: Dynamics | None, constraints: Sequence[Constraint],
                  ocp: OCP | None = None) -> None:
-        self.robot, self.dynamics, self.constraints = problem.robot, dynamics, tuple(constraints)
+        self.dynamics, self.constraints = dynamics, tuple(constraints)
         self.ocp = ocp or RobotOCP(problem.robot)
         self.w, self.p = Layout("w"), Layout("p")
+        self.ocp.declare(self.w)
         self.mu, margin, limit_scale = (self.p.add(name) for name in ("mu", "margin", "limit_scale"))
         self.contexts = [Context(dynamics, margin, limit_scale, {
             name: self.p.add(f"{c.name}.{name}", *shape) for name, shape in c.parameter_shapes().items()})
@@ -56,7 +57,7 @@ class Assembly:
                           for name, shape in self.ocp.parameter_shapes().items()}
         self.ocp.use_parameters(ocp_parameters)
         self._ocp_parameters = tuple(ocp_parameters.values())
-        self._torque = self.ocp.torque(dynamics)
+        self._point = self.ocp.point_values(dynamics)
         self._point_rows: dict[int, tuple[ca.Function, np.ndarray, np.ndarray]] = {}
         self._defect: ca.Function | None = None
         self._defect_by_function = getattr(dynamics, "exact_hessian", True)  # a callback backend records its calls
@@ -68,20 +69,19 @@ class Assembly:
 
     # -- variables -----------------------------------------------------------------------------------
     def node(self, name: str) -> Node:
-        """New variables [x; ẋ; ẍ; u] (3m + n) in w under `name`."""
+        """New variables [x; u] (the OCP's width) in w under `name`."""
         return self.ocp.split(self.w.add(name, self.ocp.width))
 
     def name_knots(self, knots: Sequence[str], start: int, goal: int) -> None:
-        """Name the knot nodes `knots` (in the transcription's column order) as "X" (K, 3m + n), the chain parts
-        by the OCP's names (e.g. "q", "qd", "qdd") (K, m) and "u" (K, n); the [x, ẋ, ẍ] of knot `start` as
-        "start" and of knot `goal` as "goal"."""
-        m, X = self.ocp.chain, np.stack([self.w.index(name) for name in knots])
+        """Name the knot nodes `knots` (in the transcription's column order) as "X" (K, width) and each of the
+        OCP's parts by its name (e.g. "q", "qd", "qdd", "u") (K, size); the first `OCP.ends` values of knot `start`
+        as "start" and of knot `goal` as "goal"."""
+        X = np.stack([self.w.index(name) for name in knots])
         self.w.name("X", X)
-        for k, part in enumerate(self.ocp.parts):
-            self.w.name(part, X[:, k * m:(k + 1) * m])
-        self.w.name("u", X[:, 3 * m:])
-        self.w.name("start", X[start, :3 * m])
-        self.w.name("goal", X[goal, :3 * m])
+        for part, columns in self.ocp.part_slices().items():
+            self.w.name(part, X[:, columns])
+        self.w.name("start", X[start, :self.ocp.ends])
+        self.w.name("goal", X[goal, :self.ocp.ends])
 
     # -- rows ----------------------------------------------------------------------------------------
     @property
@@ -104,15 +104,18 @@ class Assembly:
         if not self._defect_by_function:
             self.defect(self.ocp.defect(self.dynamics, x))
             return
+        values = self.ocp.join(x)
+        parts = tuple(values[columns] for columns in self.ocp.part_slices().values())  # the Function's inputs
         if self._defect is None:
-            node = Node(*_symbols_like(x))
-            self._defect = ca.Function("defect", [*node, *self._ocp_parameters],
-                                       [self.ocp.defect(self.dynamics, node)])
-        self._call(self._defect, tuple(x), self._ocp_parameters, 0.0, 0.0, compiled=True)
+            symbols = _symbols_like(parts)
+            self._defect = ca.Function("defect", [*symbols, *self._ocp_parameters],
+                                       [self.ocp.defect(self.dynamics, self.ocp.split(ca.vertcat(*symbols)))])
+        if self._defect.numel_out(0):
+            self._call(self._defect, parts, self._ocp_parameters, 0.0, 0.0, compiled=True)
 
-    def jerk_s(self, x: Node, dxdd_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
-        """The robot's jerk times dt/ds (n, 1) at a point where the chain's ẍ has slope dẍ/ds = `dxdd_ds`."""
-        return self.ocp.jerk_s(x, dxdd_ds, dt_ds)
+    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
+        """The OCP's running-cost inputs at a point where the controls have slope du/dσ = `du_ds`."""
+        return self.ocp.running(x, du_ds, dt_ds)
 
     def objective(self, formula: Callable[..., ca.SX], inputs: Sequence[ca.SX], parameters: Sequence[ca.SX]) -> ca.SX:
         """The objective formula(*inputs, *parameters) (inputs: expressions of w and p; parameters: symbols of p),
@@ -122,25 +125,24 @@ class Assembly:
         self.objective_call = PointCall(function, tuple(inputs), tuple(parameters), 0)
         return function(*inputs, *parameters)
 
-    def point(self, x: Node, slope: Slope, dt_ds: ca.SX) -> PointValues:
-        """Values at one point where the interpolant has the slopes `slope` (du/ds, dẍ/ds)."""
-        tau, dtau_ds = self._torque(x, slope, dt_ds)
-        return PointValues(*self.ocp.robot_state(x), tau, dtau_ds, dt_ds)
+    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> PointValues:
+        """Values at one point where the controls' interpolant has the slope du/dσ = `du_ds`."""
+        return self._point(x, du_ds, dt_ds)
 
-    def path(self, x: Node, slopes: Sequence[Slope], dt_ds: ca.SX, at_knot: bool = False) -> None:
+    def path(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, at_knot: bool = False) -> None:
         """Every path constraint at one point, in the constraints' order: those not reading rates once (at a
-        knot, less those imposed as knot bounds where the OCP's chain is q), those reading dτ/ds once per
-        one-sided slope in `slopes` (none without slopes)."""
+        knot, less those imposed as knot bounds where the OCP's chain is q), those reading rates once per
+        one-sided slope du/dσ in `slopes` (none without slopes)."""
         first, *others = [self.point(x, slope, dt_ds) for slope in slopes] or [
-            self.point(x, Slope(ca.SX.zeros(self.ocp.algebraic), ca.SX.zeros(self.ocp.chain)), dt_ds)]
+            self.point(x, ca.SX.zeros(self.ocp.controls), dt_ds)]
         for index, constraint in enumerate(self.constraints):
             if _imposed(constraint, bool(slopes), at_knot and self.ocp.knot_bounds):
                 self._constraint(index, first)
         for values in others:
             self._rates(values)
 
-    def rates(self, x: Node, slopes: Sequence[Slope], dt_ds: ca.SX) -> None:
-        """The constraints reading dτ/ds at one point, once per one-sided slope in `slopes`."""
+    def rates(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX) -> None:
+        """The constraints reading rates at one point, once per one-sided slope du/dσ in `slopes`."""
         for slope in slopes:
             self._rates(self.point(x, slope, dt_ds))
 
@@ -153,7 +155,7 @@ class Assembly:
         """Constraint `index`'s rows at one point, through one CasADi Function of a symbolic point made on first
         use: the constraint's Python code runs once per NLP instead of once per point (the calls are inlined)."""
         if index not in self._point_rows:
-            point = PointValues(*_symbols_like(_point_fields(values)))
+            point = type(values)(*_symbols_like(_point_fields(values)))
             rows = self.constraints[index].evaluate(point, self.contexts[index])
             inputs = [*_point_fields(point), *_context_symbols(self.contexts[index])]
             self._point_rows[index] = ca.Function("point_rows", inputs, [rows.g]), rows.lower, rows.upper
@@ -170,7 +172,9 @@ class Assembly:
     def nlp(self, f: ca.SX, shape_key: tuple, stages: Stages | None = None) -> NLP:
         """The finished NLP with objective f, as the dynamics backend hands it to solvers (`Dynamics.lift`)."""
         g = ca.vertcat(*self.g)
-        fields = self.dynamics.lift({"x": self.w.symbol(), "p": self.p.symbol(), "f": f, "g": g})
+        fields = {"x": self.w.symbol(), "p": self.p.symbol(), "f": f, "g": g}
+        if self.dynamics is not None:
+            fields = self.dynamics.lift(fields)
         unchanged = fields["g"] is g  # a lifted (MX) NLP has no SX point calls
         return NLP(fields["x"], fields["p"], fields["f"], fields["g"], np.concatenate(self.lbg),
                    np.concatenate(self.ubg), self.w, self.p, shape_key, fields.get("exact_hessian", True), stages,
@@ -178,8 +182,8 @@ class Assembly:
 
 
 def _point_fields(values: PointValues) -> tuple:
-    """The fields of `values` in order (dataclasses.astuple would deep-copy the CasADi expressions)."""
-    return tuple(getattr(values, field.name) for field in dataclasses.fields(PointValues))
+    """The fields of `values` (a dataclass of point values: PointValues for a robot) in order (dataclasses.astuple would deep-copy the CasADi expressions)."""
+    return tuple(getattr(values, field.name) for field in dataclasses.fields(values))
 
 
 def _context_symbols(context: Context) -> tuple[ca.SX, ...]:

@@ -32,9 +32,9 @@ class Discretization(ABC):
     """An NLP built for problems of one shape, with the maps from such a problem to bounds, parameters and a
     guess, and from a solution back to a Trajectory. Parts of the NLP's vectors are read by name:
 
-      variables   the OCP's chain parts ("q", "qd", "qdd" for the robot OCP) (knots, m) and "u" (knots, n) at
-                  every knot;  "start", "goal": [x, ẋ, ẍ] (3m,) at the start and goal knots;  "tf": every copy
-                  of t_f
+      variables   the OCP's parts ("q", "qd", "qdd", "u" for the robot OCP) (knots, size) at every knot;
+                  "start", "goal": the OCP's first `ends` node values at the start and goal knots ([q, q̇, q̈]
+                  for a robot);  "tf": every copy of t_f
       parameters  "mu", "margin", "limit_scale", "<constraint>.<name>" per constraint, "ocp.<name>" per OCP
                   parameter, then the transcription's own (`own_parameters`)
 
@@ -43,9 +43,10 @@ class Discretization(ABC):
     def __init__(self, nlp: NLP, constraints: Sequence[Constraint], margin: float, ocp: OCP) -> None:
         self.nlp, self.constraints, self.margin, self.ocp = nlp, tuple(constraints), margin, ocp
 
-    def bounds(self, problem: Problem, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
-        """(lbx, ubx): the knot bounds of the constraints imposed that way (where the OCP's chain is q), the OCP's
-        own chain bounds, start and goal at rest (eq. (10)), the time bounds; everything else free."""
+    def bounds(self, problem: Problem | None, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
+        """(lbx, ubx): the knot bounds of the constraints imposed that way (where the OCP's knot_bounds allow), the
+        OCP's own bounds of its parts, its end bounds (for a robot: start and goal at rest, eq. (10)), the time
+        bounds; everything else free."""
         w = self.nlp.variables
         lbx, ubx = np.full(w.size, -np.inf), np.full(w.size, np.inf)
         knot_bounds = [c.variable_bounds(refinement.limit_scale) for c in self.constraints] if self.ocp.knot_bounds \
@@ -54,21 +55,22 @@ class Discretization(ABC):
             for name, (lower, upper) in bounds.items():
                 w.write(lbx, name, lower)
                 w.write(ubx, name, upper)
-        for name, values in zip(("start", "goal"), self.ocp.end_values(problem)):
-            w.write(lbx, name, values)
-            w.write(ubx, name, values)
-        w.write(lbx, "tf", problem.time.min)
-        w.write(ubx, "tf", problem.time.max)
+        for name, (lower, upper) in zip(("start", "goal"), self.ocp.end_bounds(problem)):
+            w.write(lbx, name, lower)
+            w.write(ubx, name, upper)
+        lower, upper = self.ocp.time_bounds(problem)
+        w.write(lbx, "tf", lower)
+        w.write(ubx, "tf", upper)
         return lbx, ubx
 
-    def parameters(self, problem: Problem, refinement: Refinement = Refinement()) -> np.ndarray:
+    def parameters(self, problem: Problem | None, refinement: Refinement = Refinement()) -> np.ndarray:
         """p for this problem after `refinement`. The clearance margin (grown by the refinement) is capped at
         MAX_MARGIN; each collision row caps it further at half its own clearance at the start and the goal, both
         fixed (`SphereCollision.margin_caps`): a larger margin would make the NLP infeasible."""
         p = self.nlp.parameters
         values = np.zeros(p.size)
         margin = min(self.margin + refinement.extra_margin, MAX_MARGIN)
-        shared = {"mu": problem.mu, "margin": margin, "limit_scale": refinement.limit_scale}
+        shared = {"mu": self.ocp.cost_weight(problem), "margin": margin, "limit_scale": refinement.limit_scale}
         owned = {f"{c.name}.{name}": value for c in self.constraints for name, value in
                  c.parameter_values(problem).items()}
         owned.update({f"ocp.{name}": value for name, value in self.ocp.parameter_values().items()})
@@ -84,7 +86,7 @@ class Discretization(ABC):
         other.ocp = ocp
         return other
 
-    def initial_guess(self, problem: Problem) -> np.ndarray:
+    def initial_guess(self, problem: Problem | None) -> np.ndarray:
         """The OCP's default guess (`OCP.guess`): for the robot OCP the paper's straight joint-space line over
         t_f = time.guess (`ocp.straight_line`)."""
         return self.encode(self.ocp.guess(problem))

@@ -1,8 +1,8 @@
 """Local collocation on a uniform mesh: what trapezoidal and Hermite–Simpson share.
 
 A method (trapezoidal.py, hermite_simpson.py) gives only its math: `collocation` (its defects on one interval),
-`interpolate` (x, ẋ, ẍ, u, du/dσ, dẍ/dσ at σ: one formula for the NLP rows and for `decode`) and `jerk_rule`
-(the quadrature of the jerk cost on an interval);
+`interpolate` (x, u, du/dσ at σ: one formula for the NLP rows and for `decode`) and `cost_rule` (the
+quadrature of the running cost on an interval);
 `MeshDiscretization` assembles the same NLP around it for both. Variables and rows are created stage by stage
 (stage k: knot k, then interval k's midpoint, check and rows), so the KKT matrix is block-banded; `staged=True`
 adds the exact stage structure fatrop needs (`ocpkit.nlp.Stages`): per-stage t_f copies T_k, end-of-interval
@@ -25,7 +25,7 @@ from ocpkit.dynamics import Dynamics
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.nlp import Refinement, Stages
 from ocpkit.problem import Problem
-from ocpkit.transcription.assembly import Assembly, Node, Slope
+from ocpkit.transcription.assembly import Assembly, Node
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP
 
@@ -33,23 +33,20 @@ CHECK_RANGE = (0.1, 0.9)  # a moved check keeps this far (fraction of h) from th
 
 
 class Local(NamedTuple):
-    """The interpolant [x, ẋ, ẍ, u] at σ inside an interval, the slope du/dσ of the scaled rigid-body torque and
-    the slope dẍ/dσ (the chain's jerk times h)."""
+    """The interpolant [x, u] at σ inside an interval and the controls' slope du/dσ."""
 
-    q: Any
-    qd: Any
-    qdd: Any
+    x: Any
     u: Any
     du_ds: Any
-    dqdd_ds: Any
 
     @property
-    def slope(self) -> Slope:
-        """(du/dσ, dẍ/dσ)."""
-        return Slope(self.du_ds, self.dqdd_ds)
+    def node(self) -> Node:
+        return Node(self.x, self.u)
 
 
-Interpolate = Callable[[Node, Node, "Node | None", Any, Any], Local]
+Rate = Callable[[Node], Any]
+"""f(x, u) at a node (`OCP.rate`)."""
+Interpolate = Callable[[Node, Node, "Node | None", Rate, Any, Any], Local]
 
 
 class MeshInterpolant:
@@ -58,7 +55,7 @@ class MeshInterpolant:
     def __init__(self, tf: float, knots: np.ndarray, mids: np.ndarray | None, interpolate: Interpolate,
                  ocp: OCP, chain: bool = False) -> None:
         self.tf, self.knots, self.mids, self.interpolate, self.ocp = tf, knots, mids, interpolate, ocp
-        self.chain = chain  # samples of the OCP's chain (Discretization.decode) instead of the robot's
+        self.chain = chain  # samples of the OCP's nodes (Discretization.decode) instead of what it reports
 
     def __call__(self, t: np.ndarray) -> Samples:
         N = len(self.knots) - 1
@@ -67,44 +64,46 @@ class MeshInterpolant:
         k = np.clip(np.floor(at).astype(int), 0, N - 1)  # interval of each t; t_f belongs to the last
         node = self.ocp.split
         mid = None if self.mids is None else node(self.mids[k])
-        v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, h, (at - k)[:, None])
-        x = Node(v.q, v.qd, v.qdd, v.u)
+        v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, self.ocp.rate, h, (at - k)[:, None])
         if self.chain:
-            return self.ocp.chain_samples(t, x, v.du_ds / h)
-        return self.ocp.samples(t, x, v.du_ds / h, v.dqdd_ds / h)
+            return self.ocp.chain_samples(t, v.node, v.du_ds / h)
+        return self.ocp.samples(t, v.node, v.du_ds / h)
 
 
 class MeshDiscretization(Discretization):
     """The NLP of `ocp` (one shape) for a local collocation method (module docstring); subclasses give
-    `midpoints`, `jerk_rule` and the two static methods. Variables per stage k: "knot{k}", ("tf{k}" if staged),
-    "mid{k}" (if midpoints), "q_check{k}", ("end{k}" if staged); "tf" once at the end unless staged. Named: "X"
-    (N+1, 3m + n), "M" (N, 3m + n), "E" (N, 3m + n), "q_check" (N, m), "tf" (every copy).
-    Own parameter "check_at" (N,): σ of each interval's check."""
+    `midpoints`, `cost_rule` and the two static methods. Variables: the OCP's own (`OCP.declare`), then per stage
+    k: "knot{k}", ("tf{k}" if staged), "mid{k}" (if midpoints), "<first part>_check{k}" (if the OCP lifts parts),
+    ("end{k}" if staged); "tf" once at the end unless staged. Named: "X" (N+1, width), "M" (N, width), "E" (N,
+    width), "<first part>_check" (N, size; "q_check" for a robot), "tf" (every copy). Own parameter "check_at"
+    (N,): σ of each interval's check."""
 
     midpoints: bool = False
     check_default: float = 0.5  # σ of every interval's check before any refinement
-    jerk_rule: tuple[tuple[float, ...], tuple[float, ...]]
-    """(σ points, weights) of the quadrature of ∫ (dq̈/dσ)ᵀ Q (dq̈/dσ) dσ over [0, 1]: exact for the robot OCP."""
+    cost_rule: tuple[tuple[float, ...], tuple[float, ...]]
+    """(σ points, weights) of the quadrature of the running cost over [0, 1]: exact for the robot OCP's."""
 
     @staticmethod
     @abstractmethod
-    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: Node | None) -> None:
-        """Add the interval's defect rows to `a` (interval length h, knots x0, x1, midpoint xm)."""
+    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: Node | None, f: Rate) -> None:
+        """Add the interval's defect rows to `a` (interval length h, knots x0, x1, midpoint xm, f = OCP.rate)."""
 
     @staticmethod
     @abstractmethod
-    def interpolate(x0: Node, x1: Node, xm: Node | None, h: Any, s: Any) -> Local:
+    def interpolate(x0: Node, x1: Node, xm: Node | None, f: Rate, h: Any, s: Any) -> Local:
         """The interval's own interpolant at σ = s ∈ [0, 1] (CasADi symbols or NumPy arrays)."""
 
-    def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint], knots: int,
-                 margin: float, staged: bool, shape_key: tuple, ocp: OCP) -> None:
+    def __init__(self, problem: Problem | None, dynamics: Dynamics | None, constraints: Sequence[Constraint],
+                 knots: int, margin: float, staged: bool, shape_key: tuple, ocp: OCP) -> None:
         N = knots
-        self.m, self.N, self.staged = ocp.chain, N, staged
+        self.N, self.staged = N, staged
+        self.lift = ocp.parts[0] if ocp.check_parts else None  # the part lifted at each interval's check
         a = Assembly(problem, dynamics, constraints, ocp)
-        x, T, mids, checks, ends = self._variables(a, N, staged)
+        x, T, mids, checks, ends = self._variables(a, N, staged, ocp)
         check_at = a.p.add("check_at", N)
 
-        jerk, rows = 0, []
+        interval_costs, rows = [], []
+        parameters = ocp.objective_parameters(a.mu)
         for k in range(N + 1):
             h = T[k] / N
             if staged and k < N:  # gap closing first: x_{k+1} − [e_k, T_k] = 0
@@ -116,33 +115,31 @@ class MeshDiscretization(Discretization):
                 a.path(x[k], [], h, at_knot=True)
             else:
                 end = ends[k] if staged else x[k + 1]
-                local = lambda s: self.interpolate(x[k], end, mids[k], h, s)  # noqa: E731
-                a.path(x[k], [local(0.0).slope], h, at_knot=True)  # the slope leaving knot k
-                self.collocation(a, h, x[k], end, mids[k])
+                local = lambda s: self.interpolate(x[k], end, mids[k], ocp.rate, h, s)  # noqa: E731
+                a.path(x[k], [local(0.0).du_ds], h, at_knot=True)  # the slope leaving knot k
+                self.collocation(a, h, x[k], end, mids[k], ocp.rate)
                 if self.midpoints:
                     a.dynamics_defect(mids[k])
-                v = local(check_at[k])
-                a.defect(checks[k] - v.q)
-                a.path(Node(checks[k], v.qd, v.qdd, v.u), [v.slope], h)
-                a.rates(end, [local(1.0).slope], h)  # the slope entering knot k + 1
-                jerk += self._jerk_integral(a, local, h, ca.DM(problem.jerk_weights)) / h
+                if self.lift is not None:
+                    v = local(check_at[k])
+                    values, size = ocp.join(v.node), self.lift[1]
+                    a.defect(checks[k] - values[:size])
+                    a.path(ocp.split(ca.vertcat(checks[k], values[size:])), [v.du_ds], h)
+                a.rates(end, [local(1.0).du_ds], h)  # the slope entering knot k + 1
+                runs = [a.running(local(s).node, local(s).du_ds, h) for s in self.cost_rule[0]]
+                interval_costs.append(ocp.lagrange(ca.vertcat(*runs), np.asarray(self.cost_rule[1]), T[k], N,
+                                                   parameters))
             rows.append(a.row_count - first)
+        ocp.boundary(a, x[0], x[N], T[N])
         stages = None
         if staged:
-            controls = a.w.index("end0").size + a.w.index("q_check0").size + (ocp.width if self.midpoints else 0)
+            controls = a.w.index("end0").size + (a.w.index(f"{self.lift[0]}_check0").size if self.lift else 0) \
+                + (ocp.width if self.midpoints else 0)
             stages = Stages((ocp.width + 1,) * (N + 1), (controls,) * N + (0,), tuple(rows))
-        super().__init__(a.nlp(T[0] + a.mu * jerk, shape_key, stages), constraints, margin, ocp)
+        objective = ocp.mayer(T[0], ocp.mayer_inputs(x[0], x[N]), parameters) + ca.sum1(ca.vertcat(*interval_costs))
+        super().__init__(a.nlp(objective, shape_key, stages), constraints, margin, ocp)
 
-    def _jerk_integral(self, a: Assembly, local: Callable[[Any], Local], h: ca.SX, weights: ca.DM) -> ca.SX:
-        """∫ (dq̈/dσ)ᵀ Q (dq̈/dσ) dσ over one interval by `jerk_rule` (weights = diag Q)."""
-        total = 0
-        for s, c in zip(*self.jerk_rule):
-            v = local(s)
-            j = a.jerk_s(Node(v.q, v.qd, v.qdd, v.u), v.dqdd_ds, h)
-            total += c * ca.dot(weights * j, j)
-        return total
-
-    def _variables(self, a: Assembly, N: int, staged: bool) -> tuple[list, list, list, list, list]:
+    def _variables(self, a: Assembly, N: int, staged: bool, ocp: OCP) -> tuple[list, list, list, list, list]:
         """Create w stage by stage (class docstring); (knots, t_f per stage, midpoints, check q, end values)."""
         x, T, mids, checks, ends = [], [], [], [], []
         for k in range(N + 1):
@@ -151,14 +148,16 @@ class MeshDiscretization(Discretization):
                 T.append(a.w.add(f"tf{k}"))
             if k < N:
                 mids.append(a.node(f"mid{k}") if self.midpoints else None)
-                checks.append(a.w.add(f"q_check{k}", self.m))
+                if self.lift is not None:
+                    checks.append(a.w.add(f"{self.lift[0]}_check{k}", self.lift[1]))
                 if staged:
                     ends.append(a.node(f"end{k}"))
         if not staged:
             T = [a.w.add("tf")] * (N + 1)
         stack = lambda prefix, count: np.stack([a.w.index(f"{prefix}{k}") for k in range(count)])  # noqa: E731
         a.name_knots([f"knot{k}" for k in range(N + 1)], start=0, goal=N)
-        a.w.name("q_check", stack("q_check", N))
+        if self.lift is not None:
+            a.w.name(f"{self.lift[0]}_check", stack(f"{self.lift[0]}_check", N))
         if self.midpoints:
             a.w.name("M", stack("mid", N))
         if staged:
@@ -181,8 +180,8 @@ class MeshDiscretization(Discretization):
         return check_at
 
     def encode(self, trajectory: Trajectory) -> np.ndarray:
-        """Sample `trajectory` at this NLP's knots, midpoints and default checks (scaled to its t_f); u is the
-        rigid-body torque rnea(q, qd, qdd) / tau_max of the sampled motion."""
+        """Sample `trajectory` at this NLP's knots, midpoints and default checks (scaled to its t_f), as
+        `OCP.columns` reads it (for a robot, u is the rigid-body torque rnea(q, qd, qdd) / tau_max)."""
         tf, N, w = trajectory.tf, self.N, self.nlp.variables
         at = lambda s: trajectory.interpolant(tf * s / N)  # noqa: E731  s in intervals
         intervals, values = np.arange(N), np.zeros(w.size)
@@ -197,8 +196,11 @@ class MeshDiscretization(Discretization):
         return values
 
     def write_checks(self, values: np.ndarray, trajectory: Trajectory, refinement: Refinement) -> None:
+        if self.lift is None:
+            return
         at = trajectory.tf * (np.arange(self.N) + self._check_at(refinement)) / self.N
-        self.nlp.variables.write(values, "q_check", trajectory.interpolant(at).q)
+        nodes = self.ocp.columns(trajectory.interpolant(at))
+        self.nlp.variables.write(values, f"{self.lift[0]}_check", nodes[:, :self.lift[1]])
 
     def decode(self, w: np.ndarray, chain: bool = False) -> Trajectory:
         layout = self.nlp.variables
@@ -229,7 +231,7 @@ class MeshTranscription(Transcription):
     def options_key(self) -> tuple:
         return self.name, self.knots, self.margin, self.staged
 
-    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
+    def build(self, problem: Problem | None, dynamics: Dynamics | None, constraints: Sequence[Constraint],
               ocp: OCP | None = None) -> MeshDiscretization:
         return self.discretization(problem, dynamics, constraints, self.knots, self.margin, self.staged,
                                    self.shape_key(dynamics, constraints, ocp), ocp or RobotOCP(problem.robot))

@@ -29,15 +29,10 @@ from ocpkit.errors import OptionError
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.nlp import Refinement
 from ocpkit.problem import Problem
-from ocpkit.transcription.assembly import Assembly, Node, Slope
+from ocpkit.transcription.assembly import Assembly
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP
 from ocpkit.transcription.polynomials import NodeFamily
-
-CHECK_PARTS = ("q", "qd", "qdd")
-"""The chain parts lifted at the check points (as variables "q_check", "qd_check", "qdd_check" (m, checks)), so
-every nonlinear row there reads local variables only."""
-
 
 @dataclass(frozen=True)
 class Grid:
@@ -76,22 +71,21 @@ class Grid:
 
 @dataclass(frozen=True)
 class PseudospectralInterpolant:
-    """The piecewise barycentric interpolant of the knot values; `columns` is (3m + n, KN + 1) in column order."""
+    """The piecewise barycentric interpolant of the knot values; `columns` is (width, KN + 1) in column order."""
 
     tf: float
     columns: np.ndarray
     ocp: OCP
     grid: Grid
-    chain: bool = False  # samples of the OCP's chain (Discretization.decode) instead of the robot's
+    chain: bool = False  # samples of the OCP's nodes (Discretization.decode) instead of what it reports
 
     def __call__(self, t: np.ndarray) -> Samples:
         L, Ld = self.grid.matrices(2.0 * np.asarray(t, dtype=float) / self.tf - 1.0)
         values, rates = L @ self.columns.T, Ld @ self.columns.T * (2.0 * self.grid.K / self.tf)
-        m = self.ocp.chain
-        x, du_dt = self.ocp.split(values), rates[:, 3 * m:]
+        x, du_dt = self.ocp.split(values), rates[:, self.ocp.states:]
         if self.chain:
             return self.ocp.chain_samples(t, x, du_dt)
-        return self.ocp.samples(t, x, du_dt, rates[:, 2 * m:3 * m])
+        return self.ocp.samples(t, x, du_dt)
 
 
 def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
@@ -102,17 +96,21 @@ def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
 
 class PseudospectralDiscretization(Discretization):
     """The NLP of `ocp` (one shape) on `grid` (docs/transcription.md), with the maps from a problem to its numbers
-    and back. Variables: knot columns "knot0".. in column order (named "X", "q", ... by the assembly), "q_check",
-    "qd_check", "qdd_check" (m, checks: the chain's x, ẋ, ẍ), "tf"; own parameters "adaptive_rows",
-    "adaptive_drows" (slots, KN + 1): L(σ_k) and d/ds L(σ_k) of the adaptive check slots."""
+    and back. Variables: the OCP's own (`OCP.declare`), knot columns "knot0".. in column order (named "X", "q",
+    ... by the assembly), "<part>_check" (size, checks) for each part the OCP lifts ("q_check", "qd_check",
+    "qdd_check" for a robot), "tf"; own parameters "adaptive_rows", "adaptive_drows" (slots, KN + 1): L(σ_k)
+    and d/ds L(σ_k) of the adaptive check slots."""
 
-    def __init__(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint], grid: Grid,
-                 margin: float, adaptive_checks: int, shape_key: tuple, ocp: OCP, end_checks: bool = False) -> None:
+    def __init__(self, problem: Problem | None, dynamics: Dynamics | None, constraints: Sequence[Constraint],
+                 grid: Grid, margin: float, adaptive_checks: int, shape_key: tuple, ocp: OCP,
+                 end_checks: bool = False) -> None:
         N, K = grid.N, grid.K
         self.grid = grid
         D, weights = grid.family.differentiation(N), grid.family.quadrature_weights(N)
         collocated, points = grid.family.collocation_mask(N), grid.family.points(N)
-        self.check_sigma = grid.in_segments(long_interval_midpoints(points, end_checks))
+        lifted = ocp.lifted
+        self.check_sigma = grid.in_segments(long_interval_midpoints(points, end_checks)) if lifted else np.zeros(0)
+        adaptive_checks = adaptive_checks if lifted else 0
         self.adaptive_default = grid.to_global(K // 2, middle_quarter_points(points, adaptive_checks))
         columns = K * N + 1
 
@@ -120,44 +118,52 @@ class PseudospectralDiscretization(Discretization):
         x = [a.node(f"knot{j}") for j in range(columns)]  # column j at σ_j: t_f first, the start last
         a.name_knots([f"knot{j}" for j in range(columns)], start=columns - 1, goal=0)
         checks = len(self.check_sigma) + adaptive_checks
-        Qc, Qdc, Qddc = (a.w.add(f"{part}_check", ocp.chain, checks) for part in CHECK_PARTS)
+        lifted_values = [a.w.add(f"{part}_check", size, checks) for part, size in lifted]
         tf = a.w.add("tf")
         rows = a.p.add("adaptive_rows", adaptive_checks, columns)  # L(σ_k), one row per slot
         drows = a.p.add("adaptive_drows", adaptive_checks, columns)  # d/ds L(σ_k)
         h = tf / (2 * K)  # dt/ds on every segment
 
-        stack = lambda nodes, part: ca.horzcat(*(getattr(v, part) for v in nodes)).T  # noqa: E731  (points, n)
-        jerk_s = []
+        runs = []
         for b in range(K):
             own = x[b * N: b * N + N + 1]
-            Q, Qd, Qdd, U = (stack(own, part) for part in Node._fields)
-            q_defect, qd_defect = collocation_defect(D, Q, Qd, h), collocation_defect(D, Qd, Qdd, h)
-            du_ds, dqdd_ds = ca.mtimes(ca.DM(D), U), ca.mtimes(ca.DM(D), Qdd)
+            X = ca.horzcat(*(v.x for v in own)).T  # (points, states)
+            F = ca.horzcat(*(ocp.rate(v) for v in own)).T
+            U = ca.horzcat(*(v.u for v in own)).T
+            defect, du_ds = collocation_defect(D, X, F, h), ca.mtimes(ca.DM(D), U)
             for i, node in enumerate(own):
                 if collocated[i]:
-                    a.defect(q_defect[i, :].T)
-                    a.defect(qd_defect[i, :].T)
-                slope = Slope(du_ds[i, :].T, dqdd_ds[i, :].T)
-                if b > 0 and i == 0:  # the joint with segment b − 1: its other one-sided torque rate
+                    a.defect(defect[i, :].T)
+                slope = du_ds[i, :].T
+                if b > 0 and i == 0:  # the joint with segment b − 1: its other one-sided rate
                     a.rates(node, [slope], h)
                 else:
                     a.dynamics_defect(node)
                     a.path(node, [slope], h, at_knot=True)
-                jerk_s.append(a.jerk_s(node, dqdd_ds[i, :].T, h))  # from (D Ẍ_b) point by point; jerk = jerk_s / h
+                runs.append(a.running(node, slope, h))  # from (D U_b) point by point
 
         fixed_rows, fixed_drows = grid.matrices(self.check_sigma)
         L, Ld = ca.vertcat(ca.DM(fixed_rows), rows), ca.vertcat(ca.DM(fixed_drows), drows)
-        Q, Qd, Qdd, U = (stack(x, part).T for part in Node._fields)  # (n, KN + 1)
-        for k in range(L.size1()):
+        values = ca.horzcat(*(ocp.join(v) for v in x))  # (width, KN + 1)
+        U = ca.horzcat(*(v.u for v in x))
+        slices = list(ocp.part_slices().values())
+        for k in range(L.size1() if lifted else 0):
             row, drow = ca.transpose(L[k, :]), ca.transpose(Ld[k, :])
-            for lifted, values in zip((Qc, Qdc, Qddc), (Q, Qd, Qdd)):
-                a.defect(lifted[:, k] - ca.mtimes(values, row))
-            a.path(Node(Qc[:, k], Qdc[:, k], Qddc[:, k], ca.mtimes(U, row)),
-                   [Slope(ca.mtimes(U, drow), ca.mtimes(Qdd, drow))], h)
+            for variable, columns in zip(lifted_values, slices):
+                a.defect(variable[:, k] - ca.mtimes(values[columns, :], row))
+            rest = slice(slices[len(lifted) - 1].stop, ocp.width)
+            node = ocp.split(ca.vertcat(*(variable[:, k] for variable in lifted_values),
+                                        ca.mtimes(values[rest, :], row)))
+            a.path(node, [ca.mtimes(U, drow)], h)
 
-        quad = ca.DM(np.kron(np.tile(weights, K), problem.jerk_weights))
-        objective = a.objective(lambda jerks, t_f, mu: t_f + mu * (2.0 * K / t_f) * ca.dot(quad, jerks ** 2),
-                                [ca.vertcat(*jerk_s), tf], [a.mu])
+        ocp.boundary(a, x[-1], x[0], tf)
+        ends, quad, per_tf = ocp.mayer_inputs(x[-1], x[0]), np.tile(weights, K), 2.0 * K
+
+        def formula(r: ca.SX, t_f: ca.SX, *rest: ca.SX) -> ca.SX:
+            inputs, parameters = rest[:len(ends)], rest[len(ends):]
+            return ocp.mayer(t_f, inputs, parameters) + ocp.lagrange(r, quad, t_f, per_tf, parameters)
+
+        objective = a.objective(formula, [ca.vertcat(*runs), tf, *ends], ocp.objective_parameters(a.mu))
         super().__init__(a.nlp(objective, shape_key), constraints, margin, ocp)
 
     # -- numbers for one problem -------------------------------------------------------------------
@@ -174,8 +180,8 @@ class PseudospectralDiscretization(Discretization):
         return sigma
 
     def encode(self, trajectory: Trajectory) -> np.ndarray:
-        """Sample `trajectory` at this NLP's knots and check times (scaled to its t_f); u is the rigid-body
-        torque rnea(q, qd, qdd) / tau_max of the sampled motion."""
+        """Sample `trajectory` at this NLP's knots and check times (scaled to its t_f), as `OCP.columns` reads it
+        (for a robot, u is the rigid-body torque rnea(q, qd, qdd) / tau_max of the sampled motion)."""
         tf, w = trajectory.tf, self.nlp.variables
         values = np.zeros(w.size)
         w.write(values, "X", self.ocp.columns(trajectory.interpolant(tf * (self.grid.knots + 1.0) / 2.0)))
@@ -185,9 +191,12 @@ class PseudospectralDiscretization(Discretization):
 
     def write_checks(self, values: np.ndarray, trajectory: Trajectory, refinement: Refinement) -> None:
         sigma = np.concatenate([self.check_sigma, self._adaptive_sigma(refinement)])
-        checks = trajectory.interpolant(trajectory.tf * (sigma + 1.0) / 2.0)
-        for part in CHECK_PARTS:
-            self.nlp.variables.write(values, f"{part}_check", getattr(checks, part).T)
+        if not len(sigma):
+            return
+        nodes = self.ocp.columns(trajectory.interpolant(trajectory.tf * (sigma + 1.0) / 2.0))
+        slices = self.ocp.part_slices()
+        for part, _ in self.ocp.lifted:
+            self.nlp.variables.write(values, f"{part}_check", nodes[:, slices[part]].T)
 
     def decode(self, w: np.ndarray, chain: bool = False) -> Trajectory:
         layout = self.nlp.variables
@@ -244,7 +253,7 @@ class Pseudospectral(Transcription):
     def options_key(self) -> tuple:
         return self.name, self.knots, self.segments, self.margin, self.adaptive_checks, self.end_checks
 
-    def build(self, problem: Problem, dynamics: Dynamics, constraints: Sequence[Constraint],
+    def build(self, problem: Problem | None, dynamics: Dynamics | None, constraints: Sequence[Constraint],
               ocp: OCP | None = None) -> PseudospectralDiscretization:
         return PseudospectralDiscretization(problem, dynamics, constraints, Grid(self.family, self.knots,
                                             self.segments), self.margin, self.adaptive_checks,

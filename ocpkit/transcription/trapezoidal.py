@@ -1,9 +1,10 @@
 """Trapezoidal collocation (`trapezoidal`), as in Kelly, *An Introduction to Trajectory Optimization*, SIAM
 Review 59 (2017), §3: a method for mesh.py.
 
-    x_{k+1} − x_k = (h/2)(f_k + f_{k+1}),   x = [q, q̇], f = [q̇, q̈], h = t_f/N
+    x_{k+1} − x_k = (h/2)(f_k + f_{k+1}),   f = f(x, u) (for a robot x = [q, q̇], f = [q̇, q̈]), h = t_f/N
 
-Interpolant: q̈ and u piecewise linear, the states piecewise quadratic (`quadratic_state`), written through
+Interpolant: the controls (for a robot q̈ and u) piecewise linear, the states piecewise quadratic
+(`quadratic_state`), written through
 *both* knots whatever the defect's residual (why: docs/transcription.md, section "Trapezoidal collocation").
 
 Equations: docs/transcription.md, section "Mesh methods", "Trapezoidal collocation".
@@ -16,7 +17,7 @@ from typing import Any
 import casadi as ca
 
 from ocpkit.transcription.assembly import Assembly, Node
-from ocpkit.transcription.mesh import Local, MeshDiscretization, MeshTranscription
+from ocpkit.transcription.mesh import Local, MeshDiscretization, MeshTranscription, Rate
 
 
 def quadratic_state(x0: Any, x1: Any, f0: Any, f1: Any, h: Any, s: Any) -> Any:
@@ -28,19 +29,16 @@ class TrapezoidalDiscretization(MeshDiscretization):
     """Trapezoidal collocation on N intervals (module docstring); no midpoint variables."""
 
     midpoints = False
-    jerk_rule = ((0.5,), (1.0,))  # (dq̈/dσ)² is constant on an interval for the robot OCP
+    cost_rule = ((0.5,), (1.0,))  # the robot OCP's (dq̈/dσ)² is constant on an interval
 
     @staticmethod
-    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: None) -> None:
-        a.defect(x1.q - x0.q - h / 2 * (x0.qd + x1.qd))  # x_k+1 − x_k = (h/2)(f_k + f_k+1)
-        a.defect(x1.qd - x0.qd - h / 2 * (x0.qdd + x1.qdd))
+    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: None, f: Rate) -> None:
+        a.defect(x1.x - x0.x - h / 2 * (f(x0) + f(x1)))  # x_k+1 − x_k = (h/2)(f_k + f_k+1)
 
     @staticmethod
-    def interpolate(x0: Node, x1: Node, xm: None, h: Any, s: Any) -> Local:
-        return Local(q=quadratic_state(x0.q, x1.q, x0.qd, x1.qd, h, s),
-                     qd=quadratic_state(x0.qd, x1.qd, x0.qdd, x1.qdd, h, s),
-                     qdd=x0.qdd + s * (x1.qdd - x0.qdd), u=x0.u + s * (x1.u - x0.u), du_ds=x1.u - x0.u,
-                     dqdd_ds=x1.qdd - x0.qdd)
+    def interpolate(x0: Node, x1: Node, xm: None, f: Rate, h: Any, s: Any) -> Local:
+        return Local(x=quadratic_state(x0.x, x1.x, f(x0), f(x1), h, s), u=x0.u + s * (x1.u - x0.u),
+                     du_ds=x1.u - x0.u)
 
 
 class Trapezoidal(MeshTranscription):

@@ -22,7 +22,7 @@ from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import DEGREE, PathSpline, symbolic
 from ocpkit.robots import rigid_torque
 from ocpkit.transcription import TRANSCRIPTIONS
-from ocpkit.transcription.ocp import Node, PathTimingOCP, Slope
+from ocpkit.transcription.ocp import Node, PathTimingOCP
 
 CASE1 = ocpkit.load_scenario(REPO / "scenarios/paper/case1.yaml")
 ROBOT = CASE1.robot
@@ -105,9 +105,9 @@ def test_path_timing_quantities_match_finite_differences_and_pinocchio(spline):
     ocp.use_parameters(symbols)
     dynamics = make_dynamics("casadi-rnea", ROBOT)
     x, dt_ds, slope = ca.SX.sym("x", 3), ca.SX.sym("dt_ds"), ca.SX.sym("slope")
-    node = Node(x[0], x[1], x[2], ca.SX(0, 1))
+    node = Node(x[:2], x[2:])
     q, qd, qdd = ocp.robot_state(node)
-    tau, dtau_ds = ocp.torque(dynamics)(node, Slope(ca.SX(0, 1), slope), dt_ds)
+    tau, dtau_ds = ocp.torque_function(dynamics)(node, slope, dt_ds)
     jerk = ocp.jerk_s(node, slope, dt_ds) / dt_ds
     with_symbols = ca.Function("f", [x, slope, dt_ds, *symbols.values()], [q, qd, qdd, jerk, tau, dtau_ds / dt_ds])
     function = lambda *args: with_symbols(*args, *path.parameters())  # noqa: E731

@@ -13,7 +13,7 @@ from ocpkit import load_scenario
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
 from ocpkit.geometry.scene import Boxes, Cylinders
-from ocpkit.transcription.assembly import Assembly, Slope
+from ocpkit.transcription.assembly import Assembly
 
 CASE = load_scenario(REPO / "scenarios/paper/case1.yaml")
 PROBLEM = dataclasses.replace(CASE, scene=dataclasses.replace(
@@ -25,14 +25,14 @@ def test_rows_through_the_point_functions_equal_the_constraints_own():
     constraints = make_constraints(PROBLEM)
     assembly = Assembly(PROBLEM, make_dynamics("casadi-rnea", PROBLEM.robot), constraints)
     node, n = assembly.node("knot"), PROBLEM.robot.n
-    slope, dt_ds = Slope(ca.SX.sym("du_ds", n), ca.SX.sym("dxdd_ds", n)), ca.SX.sym("dt_ds")
+    slope, dt_ds = ca.SX.sym("du_ds", 2 * n), ca.SX.sym("dt_ds")  # du/dσ of the controls [q̈, u]
     assembly.path(node, [slope], dt_ds)
     values = assembly.point(node, slope, dt_ds)
     own = [constraint.evaluate(values, context) for constraint, context in zip(constraints, assembly.contexts)]
     assert len(assembly.g) == len(own) and sum(rows.g.numel() for rows in own) > 100
     collision = next(c for c in constraints if c.name == "collision")
     assert collision.obstacle_mask[:, 1:].any(axis=0).all()  # the box and the cylinder have rows
-    symbols = [assembly.w.symbol(), assembly.p.symbol(), slope.u, slope.xdd, dt_ds]
+    symbols = [assembly.w.symbol(), assembly.p.symbol(), slope, dt_ds]
     both = ca.Function("both", symbols, [ca.vertcat(*assembly.g), ca.vertcat(*(rows.g for rows in own))])
     rng = np.random.default_rng(0)
     for _ in range(5):

@@ -131,7 +131,7 @@ def test_torque_rate_is_bounded_by_the_one_sided_slopes_at_the_knots():
     knot's row with the slope into it is the one to see a rate limit that 4a meets and 8a breaks."""
     disc, k, joint = build("hermite-simpson"), 1, 0
     nlp, layout = disc.nlp, disc.nlp.variables
-    r, N, n = PROBLEM.robot, disc.N, disc.m
+    r, N, n = PROBLEM.robot, disc.N, PROBLEM.robot.n
     w = disc.encode(polynomial_motion(PROBLEM, 10.0, monomial(3)))  # slow: tiny torque rates of its own
     _, base = evaluate(disc, w, PROBLEM)
     h = 10.0 / N

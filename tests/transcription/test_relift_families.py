@@ -55,7 +55,8 @@ def test_a_refinement_round_relifts_the_checks_of_either_family(transcription, f
     refined = solve_refined(disc, solver, CASE2, w, rounds=1)
     assert refined.rounds == 1 and len(solver.starts) == 2
     layout = disc.nlp.variables
-    lifted = layout.read(solver.starts[1], "q_check")  # (m, checks) or (intervals, m): m chain values each
+    first = disc.ocp.parts[0][0]  # "q" for a robot, "s" for the path timing
+    lifted = layout.read(solver.starts[1], f"{first}_check")  # (m, checks) or (intervals, m): m chain values each
     assert (CASE2.robot.n if isinstance(disc.ocp, RobotOCP) else 1) in lifted.shape
     assert not np.allclose(solver.starts[1], solver.starts[0])  # the round moved the checks
     if family == "path-timing":
