@@ -21,11 +21,12 @@ from __future__ import annotations
 
 import functools
 import inspect
+from collections.abc import Callable
 from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
-from ocpkit.errors import RegistryError
+from ocpkit.errors import OptionError, RegistryError
 
 try:
     import tomllib
@@ -114,3 +115,12 @@ def summary(doc: str, width: int | None = None) -> str:
     if " " in cut and text[width - 1] != " ":
         cut = cut[:cut.rindex(" ")]
     return cut.rstrip(" ,;:") + "…"
+
+
+def construct(component: Callable, name: str, options: dict) -> Any:
+    """`component(**options)`; an option it does not take is the user's mistake, reported as an OptionError."""
+    try:
+        return component(**options)
+    except TypeError as exc:
+        raise OptionError(f"{name}: {exc} (options given: {sorted(options)})") from exc
+

@@ -278,7 +278,7 @@ def _check_transcription(options: dict[str, Any], where: str) -> None:
     knots (and segments)."""
     from ocpkit.dynamics import DYNAMICS
     from ocpkit.planner import GUESSES
-    from ocpkit.planner.build_cache import construct
+    from ocpkit.registry import construct
     from ocpkit.solvers import SOLVERS
     from ocpkit.transcription import TRANSCRIPTIONS
 

@@ -163,7 +163,7 @@ def _one_knot_count(args: argparse.Namespace, transcription: str) -> int:
 
 def _check_knots(transcription: str, knots: int, segments: int | None = None) -> None:
     """OptionError now, before any plan, if `transcription` does not take `knots` (and `segments`)."""
-    from ocpkit.planner.build_cache import construct
+    from ocpkit.registry import construct
     from ocpkit.transcription import TRANSCRIPTIONS
 
     options = {"knots": knots, **({"segments": segments} if segments else {})}

@@ -18,7 +18,7 @@ import inspect
 import os
 import time
 from collections import OrderedDict
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -30,6 +30,7 @@ from ocpkit.dynamics import Dynamics, make_dynamics
 from ocpkit.errors import OptionError
 from ocpkit.planner.screening import SCREEN_DISTANCE
 from ocpkit.problem import Problem
+from ocpkit.registry import construct
 from ocpkit.solvers import SOLVERS, PreparedSolver
 from ocpkit.solvers.base import STAGES_NEEDED
 from ocpkit.solvers.compiled import compile_seconds
@@ -164,10 +165,3 @@ def frozen(value: Any) -> Any:
         return tuple(frozen(item) for item in value)
     return value
 
-
-def construct(component: Callable, name: str, options: dict) -> Any:
-    """`component(**options)`; an option it does not take is the user's mistake, reported as an OptionError."""
-    try:
-        return component(**options)
-    except TypeError as exc:
-        raise OptionError(f"{name}: {exc} (options given: {sorted(options)})") from exc

@@ -21,13 +21,14 @@ from ocpkit.formats.trajectory import Trajectory
 from ocpkit.geometry.clearances import buried, sphere_centers_batch
 from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, screening
-from ocpkit.planner.build_cache import Build, build, construct
+from ocpkit.planner.build_cache import Build, build
 from ocpkit.planner.guesses import STRAIGHT_LINE_RULES
 from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb, ordered
 from ocpkit.planner.ompl_seed import hold
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.problem import Problem
+from ocpkit.registry import construct
 from ocpkit.result import Plan, Screening, Timing, finish
 from ocpkit.solvers import SolverStatus
 from ocpkit.transcription import Discretization

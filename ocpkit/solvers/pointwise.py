@@ -273,7 +273,7 @@ def _point_nonzeros(function: ca.Function, differentiated: int,
     """As `_point_derivatives`, each derivative as (a Function so named whose one output is the column of its
     nonzeros, its sparsity)."""
     symbols, lam, jacobian, hessian = _derivative_expressions(function, differentiated)
-    return [(ca.Function(name, inputs, [d.nz[:]]), d.sparsity())
+    return [(ca.Function(name, inputs, [ca.vec(d.nz[:])]), d.sparsity())  # a column even for a one-row F
             for name, inputs, d in zip(names, (symbols, [*symbols, lam]), (jacobian, hessian))]
 
 

@@ -5,7 +5,7 @@ w) and adds its rows in the order it wants them; the assembly supplies the rest 
 against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP unless told otherwise):
 
 - the shared parameters p = [μ, margin, limit_scale, each constraint's own parameters, the OCP's, ...];
-- the nodes [x, u] (the OCP's states and controls) and the OCP's own variables (`OCP.declare`);
+- the nodes [x, u] (the OCP's states and controls);
 - the values at a point, `point(node, du_ds, dt_ds)`, as the OCP gives them for its path constraints
   (`OCP.point_values`; for a robot: (q, q̇, q̈), the joint torque and its rate dτ/dσ) from the interpolant's
   slope du/dσ, where dt/dσ is the transcription's (t_f/(2K) on a pseudospectral segment, h = t_f/N on a mesh
@@ -48,7 +48,6 @@ class Assembly:
         self.dynamics, self.constraints = dynamics, tuple(constraints)
         self.ocp = ocp or RobotOCP(problem.robot)
         self.w, self.p = Layout("w"), Layout("p")
-        self.ocp.declare(self.w)
         self.mu, margin, limit_scale = (self.p.add(name) for name in ("mu", "margin", "limit_scale"))
         self.contexts = [Context(dynamics, margin, limit_scale, {
             name: self.p.add(f"{c.name}.{name}", *shape) for name, shape in c.parameter_shapes().items()})
@@ -182,7 +181,8 @@ class Assembly:
 
 
 def _point_fields(values: PointValues) -> tuple:
-    """The fields of `values` (a dataclass of point values: PointValues for a robot) in order (dataclasses.astuple would deep-copy the CasADi expressions)."""
+    """The fields of `values` (a dataclass of point values: PointValues for a robot) in order (dataclasses.astuple
+    would deep-copy the CasADi expressions)."""
     return tuple(getattr(values, field.name) for field in dataclasses.fields(values))
 
 

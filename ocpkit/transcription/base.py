@@ -154,11 +154,11 @@ class Transcription(ABC):
     def options_key(self) -> tuple:
         """Hashable: the options that shape the NLP."""
 
-    def shape_key(self, dynamics: Dynamics, constraints: Sequence[Constraint], ocp: OCP | None = None) -> tuple:
+    def shape_key(self, dynamics: Dynamics | None, constraints: Sequence[Constraint], ocp: OCP | None = None) -> tuple:
         """Hashable, equal for problems that can share one build: the options, the dynamics backend (its robot
         included), each constraint's class and shape, and the OCP's key unless it is the robot OCP (None). Start,
         goal, time bounds, μ and obstacle positions are numbers."""
-        key = self.options_key(), dynamics.key, tuple((type(c), c.shape()) for c in constraints)
+        key = self.options_key(), dynamics and dynamics.key, tuple((type(c), c.shape()) for c in constraints)
         return key if ocp is None else (*key, ocp.key)
 
     @abstractmethod

@@ -72,10 +72,10 @@ class MeshInterpolant:
 
 class MeshDiscretization(Discretization):
     """The NLP of `ocp` (one shape) for a local collocation method (module docstring); subclasses give
-    `midpoints`, `cost_rule` and the two static methods. Variables: the OCP's own (`OCP.declare`), then per stage
+    `midpoints`, `cost_rule` and the two static methods. Variables per stage
     k: "knot{k}", ("tf{k}" if staged), "mid{k}" (if midpoints), "<first part>_check{k}" (if the OCP lifts parts),
-    ("end{k}" if staged); "tf" once at the end unless staged. Named: "X" (N+1, width), "M" (N, width), "E" (N,
-    width), "<first part>_check" (N, size; "q_check" for a robot), "tf" (every copy). Own parameter "check_at"
+    ("end{k}" if staged); "tf" once at the end unless staged. Named: "X" (N+1, width), "M" (N, width) and each
+    part's "<part>_mid" (N, size), "E" (N, width), "<first part>_check" (N, size; "q_check" for a robot), "tf" (every copy). Own parameter "check_at"
     (N,): σ of each interval's check."""
 
     midpoints: bool = False
@@ -120,6 +120,8 @@ class MeshDiscretization(Discretization):
                 self.collocation(a, h, x[k], end, mids[k], ocp.rate)
                 if self.midpoints:
                     a.dynamics_defect(mids[k])
+                if self.lift is None and self.midpoints:  # no check of its own: the path at the midpoint
+                    a.path(mids[k], [local(0.5).du_ds], h)
                 if self.lift is not None:
                     v = local(check_at[k])
                     values, size = ocp.join(v.node), self.lift[1]
@@ -159,13 +161,25 @@ class MeshDiscretization(Discretization):
         if self.lift is not None:
             a.w.name(f"{self.lift[0]}_check", stack(f"{self.lift[0]}_check", N))
         if self.midpoints:
-            a.w.name("M", stack("mid", N))
+            M = stack("mid", N)
+            a.w.name("M", M)
+            for part, columns in ocp.part_slices().items():
+                a.w.name(f"{part}_mid", M[:, columns])
         if staged:
             a.w.name("tf", stack("tf", N + 1).ravel())
             a.w.name("E", stack("end", N))
         return x, T, mids, checks, ends
 
     # -- numbers for one problem -------------------------------------------------------------------
+    def bounds(self, problem: Problem | None, refinement: Refinement = Refinement()) -> tuple[np.ndarray, np.ndarray]:
+        """The knots' bounds (`Discretization.bounds`) and the OCP's own bounds of its parts at the midpoints too."""
+        lbx, ubx = super().bounds(problem, refinement)
+        if self.midpoints:
+            for name, (lower, upper) in self.ocp.chain_bounds().items():
+                self.nlp.variables.write(lbx, f"{name}_mid", lower)
+                self.nlp.variables.write(ubx, f"{name}_mid", upper)
+        return lbx, ubx
+
     def own_parameters(self, refinement: Refinement) -> dict[str, np.ndarray]:
         """Each of the refinement's check fractions (oldest first, so the newest wins) moves the check of its
         interval there, keeping CHECK_RANGE from the knots."""

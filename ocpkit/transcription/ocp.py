@@ -61,6 +61,9 @@ class OCP(ABC):
     ends: int
     check_parts: int = 0
     knot_bounds: bool = False
+    extrapolated_controls: bool = False
+    """Whether a pseudospectral transcription fixes the controls at a knot it does not collocate (LGR's free end)
+    by extrapolation; a robot's dynamics rows fix them there already."""
 
     @property
     @abstractmethod
@@ -78,10 +81,6 @@ class OCP(ABC):
 
     def use_parameters(self, symbols: dict[str, ca.SX]) -> None:
         """Take the symbols of the declared parameters, by name, for the expressions built afterwards."""
-
-    def declare(self, w: Any) -> None:
-        """Add the OCP's own decision variables (constant in time) to the Layout w before the transcription's;
-        none by default."""
 
     @property
     def width(self) -> int:

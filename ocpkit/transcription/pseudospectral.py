@@ -32,7 +32,8 @@ from ocpkit.problem import Problem
 from ocpkit.transcription.assembly import Assembly
 from ocpkit.transcription.base import Discretization, Transcription
 from ocpkit.transcription.ocp import OCP, RobotOCP
-from ocpkit.transcription.polynomials import NodeFamily
+from ocpkit.transcription.polynomials import NodeFamily, barycentric_interpolation
+
 
 @dataclass(frozen=True)
 class Grid:
@@ -96,7 +97,7 @@ def collocation_defect(D: np.ndarray, X: ca.SX, F: ca.SX, h: ca.SX) -> ca.SX:
 
 class PseudospectralDiscretization(Discretization):
     """The NLP of `ocp` (one shape) on `grid` (docs/transcription.md), with the maps from a problem to its numbers
-    and back. Variables: the OCP's own (`OCP.declare`), knot columns "knot0".. in column order (named "X", "q",
+    and back. Variables: knot columns "knot0".. in column order (named "X", "q",
     ... by the assembly), "<part>_check" (size, checks) for each part the OCP lifts ("q_check", "qd_check",
     "qdd_check" for a robot), "tf"; own parameters "adaptive_rows", "adaptive_drows" (slots, KN + 1): L(σ_k)
     and d/ds L(σ_k) of the adaptive check slots."""
@@ -124,7 +125,7 @@ class PseudospectralDiscretization(Discretization):
         drows = a.p.add("adaptive_drows", adaptive_checks, columns)  # d/ds L(σ_k)
         h = tf / (2 * K)  # dt/ds on every segment
 
-        runs = []
+        runs, self.collocation_rows = [], []  # (column, first row of its state defect, quadrature weight)
         for b in range(K):
             own = x[b * N: b * N + N + 1]
             X = ca.horzcat(*(v.x for v in own)).T  # (points, states)
@@ -133,6 +134,7 @@ class PseudospectralDiscretization(Discretization):
             defect, du_ds = collocation_defect(D, X, F, h), ca.mtimes(ca.DM(D), U)
             for i, node in enumerate(own):
                 if collocated[i]:
+                    self.collocation_rows.append((b * N + i, a.row_count, weights[i]))
                     a.defect(defect[i, :].T)
                 slope = du_ds[i, :].T
                 if b > 0 and i == 0:  # the joint with segment b − 1: its other one-sided rate
@@ -142,6 +144,8 @@ class PseudospectralDiscretization(Discretization):
                     a.path(node, [slope], h, at_knot=True)
                 runs.append(a.running(node, slope, h))  # from (D U_b) point by point
 
+        if ocp.extrapolated_controls:
+            self._extrapolate_controls(a, x, grid)
         fixed_rows, fixed_drows = grid.matrices(self.check_sigma)
         L, Ld = ca.vertcat(ca.DM(fixed_rows), rows), ca.vertcat(ca.DM(fixed_drows), drows)
         values = ca.horzcat(*(ocp.join(v) for v in x))  # (width, KN + 1)
@@ -165,6 +169,22 @@ class PseudospectralDiscretization(Discretization):
 
         objective = a.objective(formula, [ca.vertcat(*runs), tf, *ends], ocp.objective_parameters(a.mu))
         super().__init__(a.nlp(objective, shape_key), constraints, margin, ocp)
+
+    def _extrapolate_controls(self, a: Assembly, x: list, grid: Grid) -> None:
+        """Rows u_j = (the degree N − 1 interpolant of its segment's collocated controls)(s_j) at every knot that
+        no segment collocates (LGR's free end): nothing else fixes u there, and a free value would bend the
+        control's polynomial everywhere."""
+        N, points = grid.N, grid.family.points(grid.N)
+        mask = grid.family.collocation_mask(N)
+        collocated = {b * N + i for b in range(grid.K) for i in np.flatnonzero(mask)}
+        for b in range(grid.K):
+            for m in np.flatnonzero(~mask):
+                if b * N + m in collocated:
+                    continue
+                others = np.flatnonzero(mask)
+                weights = grid.family.barycentric_weights(N)[others] * (points[others] - points[m])
+                row = barycentric_interpolation(points[others], weights, points[m:m + 1])[0]
+                a.defect(x[b * N + m].u - sum(c * x[b * N + i].u for c, i in zip(row, others)))
 
     # -- numbers for one problem -------------------------------------------------------------------
     def own_parameters(self, refinement: Refinement) -> dict[str, np.ndarray]:
