@@ -21,7 +21,9 @@ PAGES = [
     "concepts/solvers", "concepts/verify", "concepts/planner", "concepts/ladder", "concepts/baselines",
     "api/index", "api/ocpkit", "api/planner", "api/simultaneous", "api/ladder", "api/result", "api/verify",
     "api/problem", "api/transcription", "api/dynamics", "api/constraints", "api/solvers", "api/nlp",
-    "api/scenario", "api/trajectory", "api/baselines",
+    "api/scenario", "api/trajectory", "api/baselines", "api/ocp", "api/problems", "concepts/ocp", "classics",
+    "notebooks/a_transcription_by_hand", "notebooks/b_nodes_and_convergence", "notebooks/c_costates",
+    "notebooks/d_pendulum_to_robot", "notebooks/e_swapping_components",
 ]
 """Every page the site must have (docs/PAGE.md → PAGE.html: the site uses file URLs)."""
 
@@ -31,7 +33,7 @@ API_MODULES = {
     "api/problem": "ocpkit.problem", "api/transcription": "ocpkit.transcription", "api/dynamics": "ocpkit.dynamics",
     "api/constraints": "ocpkit.constraints", "api/solvers": "ocpkit.solvers", "api/nlp": "ocpkit.nlp",
     "api/scenario": "ocpkit.formats.scenario", "api/trajectory": "ocpkit.formats.trajectory",
-    "api/baselines": "ocpkit.baselines",
+    "api/baselines": "ocpkit.baselines", "api/ocp": "ocpkit.ocp", "api/problems": "ocpkit.problems",
 }
 """The public API each reference page documents (its `::: module` block)."""
 

@@ -1,4 +1,4 @@
-"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper|convergence|solvers|random|run`, `ocpkit report`,
+"""Command line: `ocpkit plan SCENARIO`, `ocpkit bench paper|convergence|solvers|random|run|classics`, `ocpkit report`,
 `ocpkit show`, `ocpkit list`.
 
 Exit codes: 0 planned and verified (bench, list: done); 1 planned but not verified (the status and the hint say
@@ -113,7 +113,13 @@ def _bench_command(args: argparse.Namespace) -> int:
         return run_command(args, check_writable)
     out = Path(args.out or f"results/{args.suite}")
     check_writable(out, folder=True)
-    if args.suite == "perf":
+    if args.suite == "classics":
+        from ocpkit.bench.classics import run_classics
+
+        run_classics(out, problems=tuple(args.problems or ()), transcriptions=tuple(args.transcriptions or ()),
+                     grids=tuple(args.knots or ()), solvers=tuple(args.solvers or ("ipopt",)),
+                     peers=tuple(args.peers or ()))
+    elif args.suite == "perf":
         from ocpkit.bench.perf import run_perf
 
         run_perf(Path(args.scenarios), out, repeats=args.repeats or 5, quick=args.quick)
@@ -248,12 +254,14 @@ def parser() -> argparse.ArgumentParser:
                    "when interrupted)")
     p.set_defaults(run=_plan_command)
     b = commands.add_parser("bench", help="run a benchmark suite", epilog=exit_codes)
-    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "shapes", "run", "perf"],
+    b.add_argument("suite", choices=["paper", "convergence", "solvers", "random", "shapes", "run", "perf", "classics"],
                    help="paper: Table II; convergence: t_f error and dynamics residual vs knots per transcription; "
                    "solvers: every NLP solver x dynamics backend on the paper cases; random: seeded random "
                    "industrial6 problems with obstacles in the way; shapes: what boxes and cylinders cost "
                    "(scenarios/shapes/boxes.yaml with and without them); run: a suite file (scenarios x methods x "
-                   "repeats); perf: where a paper plan's time goes, and growth with knots, obstacles and joints")
+                   "repeats); perf: where a paper plan's time goes, and growth with knots, obstacles and joints; "
+                   "classics: the classic OCPs against their published optima, every transcription (and --peers "
+                   "rockit)")
     b.add_argument("--scenarios", default="scenarios/paper", help="folder with case1..4.yaml (default "
                    "scenarios/paper, relative to the current folder)")
     b.add_argument("--hard", default="scenarios/hard", help="folder of harder scenarios for the seeding comparison "
@@ -269,8 +277,13 @@ def parser() -> argparse.ArgumentParser:
     b.add_argument("--staged", action="store_true", help="solvers: give the mesh transcriptions' NLP its stage "
                    "structure (what fatrop exploits)")
     b.add_argument("--knots", type=int, nargs="+", help="paper: knot counts N (default 12 8); solvers, random: one N "
-                   "(default 12)")
+                   "(default 12); classics: the grids (default each transcription's own; several: convergence plots)")
     b.add_argument("--segments", type=int, help="paper: pseudospectral segments K (chebyshev, lgl, lgr)")
+    b.add_argument("--problems", nargs="+", help="classics: the problems (default all: ocpkit.problems)")
+    b.add_argument("--transcriptions", nargs="+", help=f"classics: the transcriptions (default all: "
+                   f"{_names(TRANSCRIPTIONS)})")
+    b.add_argument("--peers", nargs="+", help="classics: other tools solving the same problems: rockit (pip install "
+                   "ocpkit[peers])")
     b.add_argument("--solvers", nargs="+", help=f"solvers: the solvers to run (default all: {_names(SOLVERS)})")
     b.add_argument("--dynamics", nargs="+", help=f"solvers: the dynamics backends to run (default all: "
                    f"{_names(DYNAMICS)})")

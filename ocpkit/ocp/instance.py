@@ -11,6 +11,7 @@ calls it at each point; no check points are lifted between knots (`check_parts` 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -116,8 +117,13 @@ class ModelOCP(OCP):
 
     def rate(self, x: Node) -> Any:
         if isinstance(x.x, np.ndarray):
-            return np.asarray(self._f.map(len(x.x))(x.x.T, x.u.T)).T.reshape(x.x.shape)
+            return np.asarray(self._mapped(len(x.x))(x.x.T, x.u.T)).T.reshape(x.x.shape)
         return self._f(x.x, x.u)
+
+    @functools.lru_cache(maxsize=8)  # noqa: B019  (one instance per solve; the maps are small)
+    def _mapped(self, points: int) -> ca.Function:
+        """f over `points` nodes at once."""
+        return self._f.map(points)
 
     def point_values(self, dynamics: Any) -> PointFunction:
         return lambda x, du_ds, dt_ds: ModelPoint(x.x, x.u, du_ds, dt_ds)
@@ -161,19 +167,19 @@ class ModelOCP(OCP):
         return {v.name: (v.lower / v.scale, v.upper / v.scale) for v in self.model.variables}
 
     def guess(self, problem: Problem | None) -> Trajectory:
-        """Each state on the line from its start to its end value (fixed ones, else its guess) over T_guess; the
-        parameters and controls at their guesses."""
+        """Each state on the line from its start to its end value (fixed ones, else its guess) over T_guess, or its
+        guess function of τ = t/T_guess; the parameters and controls at their guesses (scaled)."""
         model, T = self.model, self.model.T_guess
         held = [*model.states, *model.parameters]
-        first = np.concatenate([np.where(np.isnan(v.start), v.guess, v.start) / v.scale for v in held])
-        last = np.concatenate([np.where(np.isnan(v.end), v.guess, v.end) / v.scale for v in held])
-        u = np.concatenate([v.guess / v.scale for v in model.controls] or [np.zeros(0)])
+
+        def values(variables: list, t: np.ndarray) -> np.ndarray:
+            columns = [v.guess_at(t / T) / v.scale for v in variables]
+            return np.hstack(columns) if columns else np.zeros((len(t), 0))
 
         def line(t: np.ndarray) -> Samples:
             t = np.asarray(t, dtype=float)
-            x = first + np.outer(t / T, last - first)
-            controls = np.tile(u, (len(t), 1))
-            return self.chain_samples(t, Node(x, controls), np.zeros_like(controls))
+            controls = values(model.controls, t)
+            return self.chain_samples(t, Node(values(held, t), controls), np.zeros_like(controls))
 
         return Trajectory(line(np.array([0.0, T])), line)
 

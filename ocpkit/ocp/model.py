@@ -15,6 +15,7 @@ running cost; `ocp.T` is t_f, readable at the end. Units are the user's. Nothing
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import casadi as ca
@@ -23,20 +24,23 @@ import numpy as np
 from ocpkit.errors import OptionError
 
 INF = float("inf")
+Guess = float | list | Callable[[np.ndarray], np.ndarray] | None
+"""A variable's guess: a value (one or `size` numbers), a function of τ = t/t_f ∈ [0, 1], or None (a default)."""
 RESERVED = re.compile(r"(X|M|E|tf|start|goal|check_at|mu|margin|limit_scale|(knot|mid|end|tf)\d+)")
 """Names the transcriptions give parts of the NLP's vectors themselves."""
 
 
 @dataclass(frozen=True)
 class Variable:
-    """One declared state, control or parameter: its symbol (size, 1), bounds and guess (size,), scale (size,)
+    """One declared state, control or parameter: its symbol (size, 1), bounds (size,), guess (size,) or a function
+    of τ = t/t_f, scale (size,)
     (the transcription's variable is the value divided by it), fixed values at the start and end (NaN: free)."""
 
     name: str
     symbol: ca.SX
     lower: np.ndarray
     upper: np.ndarray
-    guess: np.ndarray
+    guess: np.ndarray | Callable[[np.ndarray], np.ndarray]
     scale: np.ndarray
     start: np.ndarray
     end: np.ndarray
@@ -44,6 +48,15 @@ class Variable:
     @property
     def size(self) -> int:
         return self.symbol.numel()
+
+    def guess_at(self, tau: np.ndarray) -> np.ndarray:
+        """The guess (points, size) at normalized times τ = t/t_f (points,): the guess function, or the line from
+        the start to the end value where they are fixed (the constant guess elsewhere)."""
+        tau = np.asarray(tau, dtype=float)
+        if callable(self.guess):
+            return np.asarray(self.guess(tau), dtype=float).reshape(len(tau), self.size)
+        first, last = (np.where(np.isnan(fixed), self.guess, fixed) for fixed in (self.start, self.end))
+        return first + np.outer(tau, last - first)
 
 
 @dataclass(frozen=True)
@@ -77,15 +90,16 @@ class Ocp:
 
     # -- declarations ----------------------------------------------------------------------------------
     def state(self, name: str, size: int = 1, lower: float | list = -INF, upper: float | list = INF,
-              start: float | list | None = None, end: float | list | None = None, guess: float | list | None = None,
+              start: float | list | None = None, end: float | list | None = None, guess: Guess = None,
               scale: float | list = 1.0) -> ca.SX:
         """A state x (size, 1) with bounds on [0, t_f], optional fixed values at the start and the end, a guess
-        (default: the line from start to end where fixed, else the middle of finite bounds, else 0) and a
-        scale."""
+        (a value, or a function of the normalized time τ = t/t_f (points,) ↦ (points,) or (points, size); by
+        default the line from the start to the end value where they are fixed, else the middle of finite bounds,
+        else 0) and a scale."""
         return self._declare(self.states, name, size, lower, upper, start, end, guess, scale)
 
     def control(self, name: str, size: int = 1, lower: float | list = -INF, upper: float | list = INF,
-                guess: float | list | None = None, scale: float | list = 1.0) -> ca.SX:
+                guess: Guess = None, scale: float | list = 1.0) -> ca.SX:
         """A control u (size, 1) with bounds, guess and scale; the transcription interpolates it as its own
         polynomial, so `rate(u)` is defined."""
         return self._declare(self.controls, name, size, lower, upper, None, None, guess, scale)
@@ -112,7 +126,9 @@ class Ocp:
             raise OptionError(f"{self.name}: {name}.scale must be > 0")
         fixed = [np.full(size, np.nan) if v is None else vector(v, what) for v, what in ((start, "start"),
                                                                                       (end, "end"))]
-        if guess is None:
+        if callable(guess):
+            guess_value = guess
+        elif guess is None:
             known = [v for v in fixed if not np.any(np.isnan(v))]
             finite = np.isfinite(lo) & np.isfinite(hi)
             middle = np.where(finite, (np.where(finite, lo, 0) + np.where(finite, hi, 0)) / 2, np.clip(0.0, lo, hi))
@@ -131,6 +147,11 @@ class Ocp:
     def T(self) -> ca.SX:
         """t_f (s) as a symbol, for `at_end` and `minimize_end` (fixed or free)."""
         return self._T
+
+    @property
+    def rates(self) -> dict[str, ca.SX]:
+        """Control name → the symbol of its rate, for the controls whose `rate` was asked for."""
+        return dict(self._rates)
 
     def rate(self, control: ca.SX) -> ca.SX:
         """u̇ of a declared control, as a symbol for `subject_to` and `minimize_integral`."""

@@ -4,6 +4,7 @@ dense interpolant, the multipliers and, for the pseudospectral transcriptions, c
 from __future__ import annotations
 
 import functools
+import time
 from dataclasses import dataclass
 
 import casadi as ca
@@ -16,14 +17,16 @@ from ocpkit.registry import construct
 from ocpkit.solvers import SOLVERS, SolverResult
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 
-SOLVER_DEFAULTS = {"ipopt": {"tol": 1e-10}}
-"""Options a solver gets unless told otherwise: the classic problems' optima are compared to 1e-6 and more."""
+SOLVER_DEFAULTS = {"ipopt": {"tol": 1e-10, "bound_relax_factor": 0.0}}
+"""Options a solver gets unless told otherwise: the classic problems' optima are compared to 1e-6 and more, which
+IPOPT's default relaxation of the bounds by 1e-8 would spoil on a state-constrained arc."""
 
 
 @dataclass(frozen=True)
 class Solution:
-    """A solved `Ocp`: status, iterations, wall time (s), objective, t_f (s), the discretization and the solver's
-    result (w, multipliers). Values in the user's units at any t ∈ [0, t_f] through `x`, `u`, `p`."""
+    """A solved `Ocp`: status, iterations, wall time of the solve (s), objective, t_f (s), the discretization and
+    the solver's result (w, multipliers), the set-up time (s). Values in the user's units at any t ∈ [0, t_f]
+    through `x`, `u`, `p`."""
 
     model: Ocp
     ocp: ModelOCP
@@ -32,6 +35,8 @@ class Solution:
     objective: float
     transcription: str
     knots: int
+    setup_time: float = 0.0
+    """Building the NLP and preparing the solver (s)."""
 
     @property
     def status(self) -> str:
@@ -116,6 +121,7 @@ def solve(model: Ocp, transcription: str = "chebyshev", knots: int = 30, solver:
           transcription_options: dict | None = None, solver_options: dict | None = None) -> Solution:
     """Discretize `model` with the transcription `transcription` (`ocpkit list`; its options, e.g. segments, in
     `transcription_options`) at `knots` and solve it with `solver` from the model's guess."""
+    began = time.perf_counter()
     ocp = ModelOCP(model)
     method = construct(TRANSCRIPTIONS.get(transcription), transcription,
                        {"knots": knots, **(transcription_options or {})})
@@ -123,9 +129,10 @@ def solve(model: Ocp, transcription: str = "chebyshev", knots: int = 30, solver:
     nlp = discretization.nlp
     options = {**SOLVER_DEFAULTS.get(solver, {}), **(solver_options or {})}
     prepared = construct(SOLVERS.get(solver), solver, options).prepare(nlp)
+    setup_time = time.perf_counter() - began
     bounds, parameters = discretization.bounds(None), discretization.parameters(None)
     guess = np.clip(discretization.initial_guess(None), *bounds)
     result = prepared.solve(guess, parameters, bounds)
     objective = float(ca.Function("f", [nlp.x, nlp.p], [nlp.f])(result.w, parameters))
-    return Solution(model, ocp, discretization, result, objective, transcription, knots)
+    return Solution(model, ocp, discretization, result, objective, transcription, knots, setup_time)
 

@@ -72,11 +72,11 @@ class MeshInterpolant:
 
 class MeshDiscretization(Discretization):
     """The NLP of `ocp` (one shape) for a local collocation method (module docstring); subclasses give
-    `midpoints`, `cost_rule` and the two static methods. Variables per stage
-    k: "knot{k}", ("tf{k}" if staged), "mid{k}" (if midpoints), "<first part>_check{k}" (if the OCP lifts parts),
-    ("end{k}" if staged); "tf" once at the end unless staged. Named: "X" (N+1, width), "M" (N, width) and each
-    part's "<part>_mid" (N, size), "E" (N, width), "<first part>_check" (N, size; "q_check" for a robot), "tf" (every copy). Own parameter "check_at"
-    (N,): σ of each interval's check."""
+    `midpoints`, `cost_rule` and the two static methods. Variables per stage k: "knot{k}", ("tf{k}" if staged),
+    "mid{k}" (if midpoints), "<first part>_check{k}" (if the OCP lifts parts), ("end{k}" if staged); "tf" once at
+    the end unless staged. Named: "X" (N+1, width), "M" (N, width) and each part's "<part>_mid" (N, size), "E"
+    (N, width), "<first part>_check" (N, size; "q_check" for a robot), "tf" (every copy). Own parameter
+    "check_at" (N,): σ of each interval's check."""
 
     midpoints: bool = False
     check_default: float = 0.5  # σ of every interval's check before any refinement

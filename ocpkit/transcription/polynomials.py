@@ -10,6 +10,8 @@ docs/transcription.md, section "Pseudospectral".
 
 from __future__ import annotations
 
+import functools
+
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -59,13 +61,20 @@ class NodeFamily:
     quadrature_weights: Callable[[int], np.ndarray]
     collocated: Callable[[int], np.ndarray] | None = None
 
+    def __post_init__(self) -> None:
+        """Each family's numbers computed once per n (a decoded trajectory evaluates them at every call)."""
+        for name in ("points", "barycentric_weights", "quadrature_weights"):
+            object.__setattr__(self, name, _computed_once(getattr(self, name)))
+        object.__setattr__(self, "_differentiation", _computed_once(
+            lambda n: barycentric_differentiation(self.points(n), self.barycentric_weights(n))))
+
     def collocation_mask(self, n: int) -> np.ndarray:
         """Bool (n+1,): where D X = h F is imposed."""
         return np.ones(n + 1, dtype=bool) if self.collocated is None else self.collocated(n)
 
     def differentiation(self, n: int) -> np.ndarray:
         """D, shape (n+1, n+1): exact derivative at the points of the degree-n interpolant."""
-        return barycentric_differentiation(self.points(n), self.barycentric_weights(n))
+        return self._differentiation(n)
 
     def interpolation(self, n: int, s: np.ndarray) -> np.ndarray:
         """L, shape (len(s), n+1): the degree-n interpolant of the point values at s."""
@@ -74,6 +83,18 @@ class NodeFamily:
     def derivative(self, n: int, s: np.ndarray) -> np.ndarray:
         """L', shape (len(s), n+1): d/ds of the degree-n interpolant at s."""
         return self.interpolation(n, s) @ self.differentiation(n)
+
+
+def _computed_once(function: Callable[[int], np.ndarray]) -> Callable[[int], np.ndarray]:
+    """`function` of n with its results kept (read-only arrays)."""
+
+    @functools.cache
+    def once(n: int) -> np.ndarray:
+        value = np.array(function(n))
+        value.flags.writeable = False
+        return value
+
+    return once
 
 
 def lobatto_points(n: int) -> np.ndarray:
