@@ -1,6 +1,7 @@
 """ocpkit: robot motion planning as an optimal control problem (path and timing together).
 
-Public API: load_scenario, load_robot, Problem, plan, build, Trajectory, verify.
+Public API: load_scenario, load_robot, Problem, plan, build, Trajectory, verify; any optimal control problem:
+ocpkit.ocp (Ocp, solve, certify) and its classic test problems, ocpkit.problems.
 """
 
 import os

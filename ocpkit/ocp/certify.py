@@ -1,4 +1,4 @@
-"""Certify a solved `Ocp` densely: re-integrate ẋ = f(x, u, p) from the solution's start with its own control
+"""Certify a solved `Ocp` densely: re-integrate ẋ = f(x, u, p, t) from the solution's start with its own control
 u(t) (SciPy's `solve_ivp`, LSODA: it switches to a stiff method where the problem is stiff), and check every
 bound, path row and end row on a grid. The right-hand side is made here from the `Ocp`'s own expressions in the
 user's units, apart from the transcription's scaled NLP.
@@ -68,9 +68,9 @@ def check(model: Ocp, t: np.ndarray, x: np.ndarray, u: np.ndarray, du: np.ndarra
     """The certificate of a solution of `model` given at times t (points,) as x (points, states + parameters), u and
     u̇ (points, controls), with `control` its control at any time (user units)."""
     held = [*model.states, *model.parameters]
-    rate = ca.Function("rate", [_stack(held), _stack(model.controls)], [ca.vertcat(
+    rate = ca.Function("rate", [_stack(held), _stack(model.controls), model.t], [ca.vertcat(
         *(model.derivatives[v.name] for v in model.states), ca.DM.zeros(sum(v.size for v in model.parameters)))])
-    rhs = lambda time, state: np.asarray(rate(state, control(time))).ravel()  # noqa: E731
+    rhs = lambda time, state: np.asarray(rate(state, control(time), time)).ravel()  # noqa: E731
     integrated = solve_ivp(rhs, (t[0], t[-1]), x[0], method="LSODA", t_eval=t, rtol=rtol, atol=atol)
     error = np.abs(integrated.y.T - x) if integrated.success else np.full_like(x, np.inf)
     state_error = float(np.max(error / (1.0 + np.max(np.abs(x), axis=0))))
@@ -82,8 +82,8 @@ def check(model: Ocp, t: np.ndarray, x: np.ndarray, u: np.ndarray, du: np.ndarra
     rates = [model.rate(v.symbol) for v in model.controls]
     arguments = [values[v.name] for v in model.variables] + list(_columns(model.controls, du))
     for number, row in enumerate(model.path):
-        function = ca.Function("row", [*real, *rates], [row.expr])
-        rows = np.asarray(function.map(len(t))(*(a.T for a in arguments))).T
+        function = ca.Function("row", [*real, *rates, model.t], [row.expr])
+        rows = np.asarray(function.map(len(t))(*(a.T for a in arguments), t[None, :])).T
         excesses[f"path row {number}"] = _excess(rows, row.lower, row.upper)
     for where, rows, index in (("at_start", model.start, 0), ("at_end", model.end, -1)):
         for number, row in enumerate(rows):

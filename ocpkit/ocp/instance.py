@@ -29,12 +29,13 @@ from ocpkit.transcription.ocp import OCP, Node, PointFunction
 
 @dataclass(frozen=True)
 class ModelPoint:
-    """Scaled values at one point: x̃ (states + parameters, 1), ũ (controls, 1), du/dσ (controls, 1), dt/dσ."""
+    """Scaled values at one point: x̃ (states + parameters, 1), ũ (controls, 1), du/dσ (controls, 1), dt/dσ, t (s)."""
 
     x: ca.SX
     u: ca.SX
     du_ds: ca.SX
     dt_ds: ca.SX
+    t: ca.SX
 
 
 class ModelPath(Constraint):
@@ -49,7 +50,7 @@ class ModelPath(Constraint):
         return (self.function.name(), len(self.lower))
 
     def evaluate(self, point: ModelPoint, context: Context) -> Rows:
-        return Rows(self.function(point.x, point.u, point.du_ds / point.dt_ds), self.lower, self.upper)
+        return Rows(self.function(point.x, point.u, point.du_ds / point.dt_ds, point.t), self.lower, self.upper)
 
 
 class ModelRatePath(ModelPath):
@@ -75,8 +76,8 @@ class ModelOCP(OCP):
         self.ends = self.states
         self.x_scale = np.concatenate([v.scale for v in held])
         self.u_scale = np.concatenate([v.scale for v in model.controls]) if model.controls else np.zeros(0)
-        X, U, R, T = (ca.SX.sym("X", self.states), ca.SX.sym("U", self.controls), ca.SX.sym("R", self.controls),
-                      model.T)
+        X, U, R, T, t = (ca.SX.sym("X", self.states), ca.SX.sym("U", self.controls),
+                         ca.SX.sym("R", self.controls), model.T, model.t)
         real = [ca.vertcat(*(v.symbol for v in held)), ca.vertcat(*(v.symbol for v in model.controls)),
                 ca.vertcat(*(model.rate(v.symbol) for v in model.controls))]
         scaled = [ca.DM(self.x_scale) * X, ca.DM(self.u_scale) * U, ca.DM(self.u_scale) * R]
@@ -84,19 +85,20 @@ class ModelOCP(OCP):
 
         rhs = ca.vertcat(*(model.derivatives[v.name] for v in model.states), ca.SX.zeros(self.states - sum(
             v.size for v in model.states)))
-        self._f = self._function("dynamics", [X, U], own(rhs) / ca.DM(self.x_scale), "set_der", [R, T])
+        self._f = self._function("dynamics", [X, U, t], own(rhs) / ca.DM(self.x_scale), "set_der", [R, T])
         rows = lambda found: ca.vertcat(*(own(r.expr) for r in found))  # noqa: E731
         bounds = lambda found: (np.concatenate([r.lower for r in found] or [np.zeros(0)]),  # noqa: E731
                                 np.concatenate([r.upper for r in found] or [np.zeros(0)]))
         plain = [r for r in model.path if not ca.depends_on(own(r.expr), R)]
         rated = [r for r in model.path if ca.depends_on(own(r.expr), R)]
         self.constraints: list[Constraint] = [
-            kind(self._function(kind.name.replace("-", "_"), [X, U, R], rows(found), "subject_to", [T]), *bounds(found))
+            kind(self._function(kind.name.replace("-", "_"), [X, U, R, t], rows(found), "subject_to", [T]),
+                 *bounds(found))
             for kind, found in ((ModelPath, plain), (ModelRatePath, rated)) if found]
-        self._running = self._function("running", [X, U, R], own(model.lagrange), "minimize_integral", [T])
-        self._mayer = self._function("mayer", [X, T], own(model.mayer), "minimize_end", [U, R])
-        self._start = self._function("start", [X], rows(model.start), "at_start", [U, R, T])
-        self._end = self._function("end", [X, T], rows(model.end), "at_end", [U, R])
+        self._running = self._function("running", [X, U, R, t], own(model.lagrange), "minimize_integral", [T])
+        self._mayer = self._function("mayer", [X, T], own(model.mayer), "minimize_end", [U, R, t])
+        self._start = self._function("start", [X], rows(model.start), "at_start", [U, R, T, t])
+        self._end = self._function("end", [X, T], rows(model.end), "at_end", [U, R, t])
         self._start_bounds, self._end_bounds = bounds(model.start), bounds(model.end)
 
     def _function(self, name: str, inputs: list[ca.SX], output: ca.SX, what: str, barred: list[ca.SX]) -> ca.Function:
@@ -115,10 +117,11 @@ class ModelOCP(OCP):
     def key(self) -> tuple:
         return "model", self.model.name, id(self.model)
 
-    def rate(self, x: Node) -> Any:
+    def rate(self, x: Node, t: Any) -> Any:
         if isinstance(x.x, np.ndarray):
-            return np.asarray(self._mapped(len(x.x))(x.x.T, x.u.T)).T.reshape(x.x.shape)
-        return self._f(x.x, x.u)
+            times = np.broadcast_to(np.asarray(t, dtype=float).ravel(), (len(x.x),))[None, :]
+            return np.asarray(self._mapped(len(x.x))(x.x.T, x.u.T, times)).T.reshape(x.x.shape)
+        return self._f(x.x, x.u, t)
 
     @functools.lru_cache(maxsize=8)  # noqa: B019  (one instance per solve; the maps are small)
     def _mapped(self, points: int) -> ca.Function:
@@ -126,10 +129,10 @@ class ModelOCP(OCP):
         return self._f.map(points)
 
     def point_values(self, dynamics: Any) -> PointFunction:
-        return lambda x, du_ds, dt_ds: ModelPoint(x.x, x.u, du_ds, dt_ds)
+        return lambda x, du_ds, dt_ds, t: ModelPoint(x.x, x.u, du_ds, dt_ds, t)
 
-    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
-        return self._running(x.x, x.u, du_ds / dt_ds)
+    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX) -> ca.SX:
+        return self._running(x.x, x.u, du_ds / dt_ds, t)
 
     def mayer_inputs(self, start: Node, goal: Node) -> list[ca.SX]:
         return [goal.x]
@@ -188,7 +191,8 @@ class ModelOCP(OCP):
 
     def chain_samples(self, t: np.ndarray, x: Node, du_dt: np.ndarray) -> Samples:
         """x̃ as the Samples' q, its rate f as qd, ũ as tau and dũ/dt as taud (qdd zeros)."""
-        return Samples(np.asarray(t, dtype=float), x.x, self.rate(x), np.zeros_like(x.x), x.u, du_dt)
+        t = np.asarray(t, dtype=float)
+        return Samples(t, x.x, self.rate(x, t), np.zeros_like(x.x), x.u, du_dt)
 
     def samples(self, t: np.ndarray, x: Node, du_dt: np.ndarray) -> Samples:
         return self.chain_samples(t, x, du_dt)

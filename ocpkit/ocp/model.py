@@ -1,14 +1,15 @@
 """The public description of an optimal control problem: `Ocp`, on CasADi symbols (in the spirit of rockit's
 `Ocp`, smaller).
 
-    minimize    Φ(x(t_f), p, t_f) + ∫ L(x, u, u̇, p) dt     (`minimize_end`, `minimize_integral`)
-    subject to  ẋ = f(x, u, p)                              (`set_der`, one per state)
-                lower ≤ h(x, u, u̇, p) ≤ upper  on [0, t_f]   (`subject_to`; bounds of `state`, `control`)
+    minimize    Φ(x(t_f), p, t_f) + ∫ L(x, u, u̇, p, t) dt  (`minimize_end`, `minimize_integral`)
+    subject to  ẋ = f(x, u, p, t)                           (`set_der`, one per state)
+                lower ≤ h(x, u, u̇, p, t) ≤ upper  on [0, t_f] (`subject_to`; bounds of `state`, `control`)
                 lower ≤ b(x(0), p) ≤ upper,  lower ≤ e(x(t_f), p, t_f) ≤ upper   (`at_start`, `at_end`)
                 t_f fixed (`Ocp(T=...)`) or free within bounds
 
 States, controls and parameters are column symbols; `ocp.rate(u)` is u̇, readable in path constraints and the
-running cost; `ocp.T` is t_f, readable at the end. Units are the user's. Nothing here discretizes: `solve`
+running cost; `ocp.t` is the time, readable in the dynamics, the path and the running cost; `ocp.T` is t_f,
+readable at the end. The initial time is 0. Units are the user's. Nothing here discretizes: `solve`
 (ocpkit.ocp.solve) hands the problem to a transcription.
 """
 
@@ -86,6 +87,7 @@ class Ocp:
         self.derivatives, self.path, self.start, self.end = {}, [], [], []
         self.mayer, self.lagrange = ca.SX(0), ca.SX(0)
         self._T = ca.SX.sym("T")
+        self._t = ca.SX.sym("t")
         self._rates: dict[str, ca.SX] = {}
 
     # -- declarations ----------------------------------------------------------------------------------
@@ -144,6 +146,11 @@ class Ocp:
         return [*self.states, *self.controls, *self.parameters]
 
     @property
+    def t(self) -> ca.SX:
+        """Time t ∈ [0, t_f] (s) as a symbol, for `set_der`, `subject_to` and `minimize_integral`."""
+        return self._t
+
+    @property
     def T(self) -> ca.SX:
         """t_f (s) as a symbol, for `at_end` and `minimize_end` (fixed or free)."""
         return self._T
@@ -161,7 +168,7 @@ class Ocp:
         return self._rates[variable.name]
 
     def set_der(self, state: ca.SX, rhs: ca.SX | float) -> None:
-        """ẋ = rhs for a declared state (rhs: expression of states, controls, parameters; same size)."""
+        """ẋ = rhs for a declared state (rhs: expression of states, controls, parameters and `t`; same size)."""
         variable = self._find(state, self.states, "set_der() takes a declared state")
         rhs = ca.SX(rhs) if not isinstance(rhs, ca.SX) else rhs
         if rhs.numel() != variable.size:
@@ -170,7 +177,7 @@ class Ocp:
         self.derivatives[variable.name] = ca.reshape(rhs, variable.size, 1)
 
     def subject_to(self, expr: ca.SX, lower: float | list = -INF, upper: float | list = INF) -> None:
-        """lower ≤ expr ≤ upper on the whole of [0, t_f] (states, controls, rates, parameters)."""
+        """lower ≤ expr ≤ upper on the whole of [0, t_f] (states, controls, rates, parameters, `t`)."""
         self.path.append(self._row(expr, lower, upper, "subject_to"))
 
     def at_start(self, expr: ca.SX, lower: float | list = -INF, upper: float | list = INF) -> None:
@@ -186,7 +193,7 @@ class Ocp:
         self.mayer = self.mayer + self._scalar(expr, "minimize_end")
 
     def minimize_integral(self, expr: ca.SX | float) -> None:
-        """Add a Lagrange term ∫ L(x, u, u̇, p) dt."""
+        """Add a Lagrange term ∫ L(x, u, u̇, p, t) dt."""
         self.lagrange = self.lagrange + self._scalar(expr, "minimize_integral")
 
     # -- checks ----------------------------------------------------------------------------------------

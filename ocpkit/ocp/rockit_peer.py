@@ -2,7 +2,7 @@
 own transcriptions against.
 
 The translation, one `Ocp` declaration to rockit's (rockit's variables are MX; the `Ocp`'s SX expressions are
-wrapped in a `casadi.Function` of (x, u, p, T, u̇) and called on rockit's symbols):
+wrapped in a `casadi.Function` of (x, u, p, T, u̇, t) and called on rockit's symbols):
 
 - a state, control or parameter → rockit `state`, `control` (piecewise constant) or `variable` (one optimized
   value), of the same size and scale; a control whose rate `ocp.rate(u)` is used → a rockit state whose derivative
@@ -78,7 +78,7 @@ def solve_with_rockit(ocp: Ocp, method: str = "multiple-shooting", intervals: in
         else:
             controls.append(peer.control(v.size, scale=_column(v.scale)))
     parameters = [peer.variable(v.size, scale=_column(v.scale)) for v in ocp.parameters]
-    call = _caller(ocp, states, controls, parameters, peer.T, rates)
+    call = _caller(ocp, states, controls, parameters, peer.T, rates, peer.t)
 
     rhs, offset = call(ca.vertcat(*(ocp.derivatives[v.name] for v in ocp.states))), 0
     for variable, symbol in zip(ocp.states, states):
@@ -126,13 +126,13 @@ def solve_with_rockit(ocp: Ocp, method: str = "multiple-shooting", intervals: in
                       parameters=np.concatenate(values).astype(float) if values else np.zeros(0))
 
 
-def _caller(ocp: Ocp, states: list, controls: list, parameters: list, T: ca.MX, rates: list):
+def _caller(ocp: Ocp, states: list, controls: list, parameters: list, T: ca.MX, rates: list, t: ca.MX):
     """A function: expr (SX of the `Ocp`'s symbols) → the same expression on rockit's MX symbols."""
     rate_symbols = [ocp.rates[v.name] for v in ocp.controls if v.name in ocp.rates]
     sx = [_stack([v.symbol for v in family]) for family in (ocp.states, ocp.controls, ocp.parameters)]
-    sx += [ocp.T, _stack(rate_symbols)]
+    sx += [ocp.T, _stack(rate_symbols), ocp.t]
     mx = [ca.vertcat(*family) if family else ca.MX(0, 1) for family in (states, controls, parameters)]
-    mx += [T, ca.vertcat(*rates) if rates else ca.MX(0, 1)]
+    mx += [T, ca.vertcat(*rates) if rates else ca.MX(0, 1), t]
 
     def call(expr: ca.SX) -> ca.MX:  # over the arguments expr uses only: a Function call depends on all its inputs
         used = [i for i, symbol in enumerate(sx) if symbol.numel() and ca.depends_on(expr, symbol)]

@@ -112,9 +112,9 @@ class Assembly:
         if self._defect.numel_out(0):
             self._call(self._defect, parts, self._ocp_parameters, 0.0, 0.0, compiled=True)
 
-    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
-        """The OCP's running-cost inputs at a point where the controls have slope du/dσ = `du_ds`."""
-        return self.ocp.running(x, du_ds, dt_ds)
+    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX) -> ca.SX:
+        """The OCP's running-cost inputs at a point at time t where the controls have slope du/dσ = `du_ds`."""
+        return self.ocp.running(x, du_ds, dt_ds, t)
 
     def objective(self, formula: Callable[..., ca.SX], inputs: Sequence[ca.SX], parameters: Sequence[ca.SX]) -> ca.SX:
         """The objective formula(*inputs, *parameters) (inputs: expressions of w and p; parameters: symbols of p),
@@ -124,26 +124,26 @@ class Assembly:
         self.objective_call = PointCall(function, tuple(inputs), tuple(parameters), 0)
         return function(*inputs, *parameters)
 
-    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> PointValues:
-        """Values at one point where the controls' interpolant has the slope du/dσ = `du_ds`."""
-        return self._point(x, du_ds, dt_ds)
+    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX | None) -> PointValues:
+        """Values at one point at time t where the controls' interpolant has the slope du/dσ = `du_ds`."""
+        return self._point(x, du_ds, dt_ds, t)
 
-    def path(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, at_knot: bool = False) -> None:
-        """Every path constraint at one point, in the constraints' order: those not reading rates once (at a
-        knot, less those imposed as knot bounds where the OCP's chain is q), those reading rates once per
+    def path(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, t: ca.SX | None, at_knot: bool = False) -> None:
+        """Every path constraint at one point at time t, in the constraints' order: those not reading rates once
+        (at a knot, less those imposed as knot bounds where the OCP's chain is q), those reading rates once per
         one-sided slope du/dσ in `slopes` (none without slopes)."""
-        first, *others = [self.point(x, slope, dt_ds) for slope in slopes] or [
-            self.point(x, ca.SX.zeros(self.ocp.controls), dt_ds)]
+        first, *others = [self.point(x, slope, dt_ds, t) for slope in slopes] or [
+            self.point(x, ca.SX.zeros(self.ocp.controls), dt_ds, t)]
         for index, constraint in enumerate(self.constraints):
             if _imposed(constraint, bool(slopes), at_knot and self.ocp.knot_bounds):
                 self._constraint(index, first)
         for values in others:
             self._rates(values)
 
-    def rates(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX) -> None:
-        """The constraints reading rates at one point, once per one-sided slope du/dσ in `slopes`."""
+    def rates(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, t: ca.SX) -> None:
+        """The constraints reading rates at one point at time t, once per one-sided slope du/dσ in `slopes`."""
         for slope in slopes:
-            self._rates(self.point(x, slope, dt_ds))
+            self._rates(self.point(x, slope, dt_ds, t))
 
     def _rates(self, values: PointValues) -> None:
         for index, constraint in enumerate(self.constraints):

@@ -43,14 +43,14 @@ class HermiteSimpsonDiscretization(MeshDiscretization):
     cost_rule = ((0.0, 0.5, 1.0), (1 / 6, 4 / 6, 1 / 6))  # Simpson: exact for the robot OCP's (dq̈/dσ)²
 
     @staticmethod
-    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: Node, f: Rate) -> None:
-        f0, f1 = f(x0), f(x1)
+    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: Node, f: Rate, t0: ca.SX) -> None:
+        f0, f1 = f(x0, t0), f(x1, t0 + h)
         a.defect(xm.x - ((x0.x + x1.x) / 2 + h / 8 * (f0 - f1)))  # x_m = (x_k + x_k+1)/2 + (h/8)(f_k − f_k+1)
-        a.defect(x1.x - x0.x - h / 6 * (f0 + 4 * f(xm) + f1))  # x_k+1 − x_k = (h/6)(f_k + 4 f_m + f_k+1)
+        a.defect(x1.x - x0.x - h / 6 * (f0 + 4 * f(xm, t0 + h / 2) + f1))  # x_k+1 − x_k = (h/6)(f_k + 4f_m + f_k+1)
 
     @staticmethod
-    def interpolate(x0: Node, x1: Node, xm: Node, f: Rate, h: Any, s: Any) -> Local:
-        return Local(x=hermite(x0.x, x1.x, f(x0), f(x1), h, s), u=quadratic(x0.u, xm.u, x1.u, s),
+    def interpolate(x0: Node, x1: Node, xm: Node, f: Rate, h: Any, s: Any, t0: Any) -> Local:
+        return Local(x=hermite(x0.x, x1.x, f(x0, t0), f(x1, t0 + h), h, s), u=quadratic(x0.u, xm.u, x1.u, s),
                      du_ds=quadratic_slope(x0.u, xm.u, x1.u, s))
 
 

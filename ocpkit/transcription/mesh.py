@@ -44,9 +44,9 @@ class Local(NamedTuple):
         return Node(self.x, self.u)
 
 
-Rate = Callable[[Node], Any]
-"""f(x, u) at a node (`OCP.rate`)."""
-Interpolate = Callable[[Node, Node, "Node | None", Rate, Any, Any], Local]
+Rate = Callable[[Node, Any], Any]
+"""f(x, u, t) at a node at time t (`OCP.rate`)."""
+Interpolate = Callable[[Node, Node, "Node | None", Rate, Any, Any, Any], Local]
 
 
 class MeshInterpolant:
@@ -64,7 +64,8 @@ class MeshInterpolant:
         k = np.clip(np.floor(at).astype(int), 0, N - 1)  # interval of each t; t_f belongs to the last
         node = self.ocp.split
         mid = None if self.mids is None else node(self.mids[k])
-        v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, self.ocp.rate, h, (at - k)[:, None])
+        v = self.interpolate(node(self.knots[k]), node(self.knots[k + 1]), mid, self.ocp.rate, h, (at - k)[:, None],
+                             k * h)
         if self.chain:
             return self.ocp.chain_samples(t, v.node, v.du_ds / h)
         return self.ocp.samples(t, v.node, v.du_ds / h)
@@ -85,13 +86,15 @@ class MeshDiscretization(Discretization):
 
     @staticmethod
     @abstractmethod
-    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: Node | None, f: Rate) -> None:
-        """Add the interval's defect rows to `a` (interval length h, knots x0, x1, midpoint xm, f = OCP.rate)."""
+    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: Node | None, f: Rate, t0: ca.SX) -> None:
+        """Add the interval's defect rows to `a` (interval length h from time t0, knots x0, x1, midpoint xm,
+        f = OCP.rate)."""
 
     @staticmethod
     @abstractmethod
-    def interpolate(x0: Node, x1: Node, xm: Node | None, f: Rate, h: Any, s: Any) -> Local:
-        """The interval's own interpolant at σ = s ∈ [0, 1] (CasADi symbols or NumPy arrays)."""
+    def interpolate(x0: Node, x1: Node, xm: Node | None, f: Rate, h: Any, s: Any, t0: Any) -> Local:
+        """The interval's own interpolant at σ = s ∈ [0, 1] of the interval from time t0 (CasADi symbols or NumPy
+        arrays)."""
 
     def __init__(self, problem: Problem | None, dynamics: Dynamics | None, constraints: Sequence[Constraint],
                  knots: int, margin: float, staged: bool, shape_key: tuple, ocp: OCP) -> None:
@@ -106,29 +109,30 @@ class MeshDiscretization(Discretization):
         parameters = ocp.objective_parameters(a.mu)
         for k in range(N + 1):
             h = T[k] / N
+            t0 = k * h  # the start of interval k
             if staged and k < N:  # gap closing first: x_{k+1} − [e_k, T_k] = 0
                 a.defect(ca.vertcat(*(next_part - end_part for next_part, end_part in zip(x[k + 1], ends[k])),
                                     T[k + 1] - T[k]))
             first = a.row_count
             a.dynamics_defect(x[k])
             if k == N:
-                a.path(x[k], [], h, at_knot=True)
+                a.path(x[k], [], h, t0, at_knot=True)
             else:
                 end = ends[k] if staged else x[k + 1]
-                local = lambda s: self.interpolate(x[k], end, mids[k], ocp.rate, h, s)  # noqa: E731
-                a.path(x[k], [local(0.0).du_ds], h, at_knot=True)  # the slope leaving knot k
-                self.collocation(a, h, x[k], end, mids[k], ocp.rate)
+                local = lambda s: self.interpolate(x[k], end, mids[k], ocp.rate, h, s, t0)  # noqa: E731
+                a.path(x[k], [local(0.0).du_ds], h, t0, at_knot=True)  # the slope leaving knot k
+                self.collocation(a, h, x[k], end, mids[k], ocp.rate, t0)
                 if self.midpoints:
                     a.dynamics_defect(mids[k])
                 if self.lift is None and self.midpoints:  # no check of its own: the path at the midpoint
-                    a.path(mids[k], [local(0.5).du_ds], h)
+                    a.path(mids[k], [local(0.5).du_ds], h, t0 + h / 2)
                 if self.lift is not None:
                     v = local(check_at[k])
                     values, size = ocp.join(v.node), self.lift[1]
                     a.defect(checks[k] - values[:size])
-                    a.path(ocp.split(ca.vertcat(checks[k], values[size:])), [v.du_ds], h)
-                a.rates(end, [local(1.0).du_ds], h)  # the slope entering knot k + 1
-                runs = [a.running(local(s).node, local(s).du_ds, h) for s in self.cost_rule[0]]
+                    a.path(ocp.split(ca.vertcat(checks[k], values[size:])), [v.du_ds], h, t0 + check_at[k] * h)
+                a.rates(end, [local(1.0).du_ds], h, t0 + h)  # the slope entering knot k + 1
+                runs = [a.running(local(s).node, local(s).du_ds, h, t0 + s * h) for s in self.cost_rule[0]]
                 interval_costs.append(ocp.lagrange(ca.vertcat(*runs), np.asarray(self.cost_rule[1]), T[k], N,
                                                    parameters))
             rows.append(a.row_count - first)

@@ -48,8 +48,9 @@ class Node(NamedTuple):
     u: Any
 
 
-PointFunction = Callable[[Node, Any, Any], Any]
-"""(node, du/dσ, dt/dσ) ↦ the values the OCP's path constraints read at that point."""
+PointFunction = Callable[[Node, Any, Any, Any], Any]
+"""(node, du/dσ, dt/dσ, t) ↦ the values the OCP's path constraints read at that point (t in s; None where the
+transcription does not form it: at the lifted check points, which only OCPs that never read t have)."""
 
 
 class OCP(ABC):
@@ -115,8 +116,9 @@ class OCP(ABC):
         return self.parts[:self.check_parts]
 
     @abstractmethod
-    def rate(self, x: Node) -> Any:
-        """ẋ = f(x, u) (states,) at a symbolic node, or rows (points, states) at NumPy nodes."""
+    def rate(self, x: Node, t: Any) -> Any:
+        """ẋ = f(x, u, t) (states,) at a symbolic node at time t, or rows (points, states) at NumPy nodes at times
+        t (points,)."""
 
     def defect(self, dynamics: Dynamics | None, x: Node) -> ca.SX:
         """The algebraic rows (k, 1) that must be 0 at a collocation point; none by default."""
@@ -127,8 +129,9 @@ class OCP(ABC):
         """The values the path constraints read at a point (`PointFunction`), on `dynamics`' expressions."""
 
     @abstractmethod
-    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
-        """The running cost's inputs (k, 1) at a quadrature point with du/dσ = `du_ds` and dt/dσ = `dt_ds`."""
+    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX) -> ca.SX:
+        """The running cost's inputs (k, 1) at a quadrature point at time t with du/dσ = `du_ds` and dt/dσ =
+        `dt_ds`."""
 
     def objective_parameters(self, mu: ca.SX) -> list[ca.SX]:
         """The NLP parameter symbols the cost reads (`mu` is the shared cost weight); none by default."""
@@ -188,7 +191,7 @@ class OCP(ABC):
 
 class ChainOCP(OCP):
     """An OCP whose states are a chain of two integrators x → ẋ (m values each) driven by the first m controls
-    ẍ: f = [ẋ, ẍ]. Its chain samples carry x, ẋ, ẍ as the Samples' q, qd, qdd and the other controls and their
+    ẍ: f = [ẋ, ẍ], time-invariant. Its chain samples carry x, ẋ, ẍ as the Samples' q, qd, qdd and the other controls and their
     rates as tau, taud; its running input is the robot's jerk times dt/dσ (`jerk_s`), which the cost
     t_f + μ ∫ q⃛ᵀ Q q⃛ dt integrates with Q = diag(1 / R²) (R the gear ratios, `Problem.jerk_weights`)."""
 
@@ -199,7 +202,7 @@ class ChainOCP(OCP):
     def __init__(self, robot: Robot) -> None:
         self.robot = robot
 
-    def rate(self, x: Node) -> Any:
+    def rate(self, x: Node, t: Any) -> Any:
         m = self.chain
         if isinstance(x.x, np.ndarray):
             return np.hstack([x.x[:, m:], x.u[:, :m]])
@@ -218,13 +221,13 @@ class ChainOCP(OCP):
 
     def point_values(self, dynamics: Dynamics | None) -> PointFunction:
         torque = self.torque_function(dynamics)
-        return lambda x, du_ds, dt_ds: PointValues(*self.robot_state(x), *torque(x, du_ds, dt_ds), dt_ds)
+        return lambda x, du_ds, dt_ds, t: PointValues(*self.robot_state(x), *torque(x, du_ds, dt_ds), dt_ds)
 
     @abstractmethod
     def torque_function(self, dynamics: Dynamics) -> Callable[[Node, Any, Any], tuple[Any, Any]]:
         """(node, du/dσ, dt/dσ) ↦ (τ, dτ/dσ), each (n, 1), N m."""
 
-    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX) -> ca.SX:
+    def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX) -> ca.SX:
         return self.jerk_s(x, du_ds[:self.chain], dt_ds)
 
     @abstractmethod

@@ -124,12 +124,13 @@ class PseudospectralDiscretization(Discretization):
         rows = a.p.add("adaptive_rows", adaptive_checks, columns)  # L(σ_k), one row per slot
         drows = a.p.add("adaptive_drows", adaptive_checks, columns)  # d/ds L(σ_k)
         h = tf / (2 * K)  # dt/ds on every segment
+        times = [tf * (sigma + 1.0) / 2.0 for sigma in grid.knots]  # t of each column
 
         runs, self.collocation_rows = [], []  # (column, first row of its state defect, quadrature weight)
         for b in range(K):
-            own = x[b * N: b * N + N + 1]
+            own, at = x[b * N: b * N + N + 1], times[b * N: b * N + N + 1]
             X = ca.horzcat(*(v.x for v in own)).T  # (points, states)
-            F = ca.horzcat(*(ocp.rate(v) for v in own)).T
+            F = ca.horzcat(*(ocp.rate(v, t) for v, t in zip(own, at))).T
             U = ca.horzcat(*(v.u for v in own)).T
             defect, du_ds = collocation_defect(D, X, F, h), ca.mtimes(ca.DM(D), U)
             for i, node in enumerate(own):
@@ -138,11 +139,11 @@ class PseudospectralDiscretization(Discretization):
                     a.defect(defect[i, :].T)
                 slope = du_ds[i, :].T
                 if b > 0 and i == 0:  # the joint with segment b − 1: its other one-sided rate
-                    a.rates(node, [slope], h)
+                    a.rates(node, [slope], h, at[i])
                 else:
                     a.dynamics_defect(node)
-                    a.path(node, [slope], h, at_knot=True)
-                runs.append(a.running(node, slope, h))  # from (D U_b) point by point
+                    a.path(node, [slope], h, at[i], at_knot=True)
+                runs.append(a.running(node, slope, h, at[i]))  # from (D U_b) point by point
 
         if ocp.extrapolated_controls:
             self._extrapolate_controls(a, x, grid)
@@ -158,7 +159,7 @@ class PseudospectralDiscretization(Discretization):
             rest = slice(slices[len(lifted) - 1].stop, ocp.width)
             node = ocp.split(ca.vertcat(*(variable[:, k] for variable in lifted_values),
                                         ca.mtimes(values[rest, :], row)))
-            a.path(node, [ca.mtimes(U, drow)], h)
+            a.path(node, [ca.mtimes(U, drow)], h, None)  # only OCPs that never read t lift checks
 
         ocp.boundary(a, x[-1], x[0], tf)
         ends, quad, per_tf = ocp.mayer_inputs(x[-1], x[0]), np.tile(weights, K), 2.0 * K

@@ -32,12 +32,12 @@ class TrapezoidalDiscretization(MeshDiscretization):
     cost_rule = ((0.0, 1.0), (0.5, 0.5))  # the trapezoidal rule: exact for the robot OCP's constant (dq̈/dσ)²
 
     @staticmethod
-    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: None, f: Rate) -> None:
-        a.defect(x1.x - x0.x - h / 2 * (f(x0) + f(x1)))  # x_k+1 − x_k = (h/2)(f_k + f_k+1)
+    def collocation(a: Assembly, h: ca.SX, x0: Node, x1: Node, xm: None, f: Rate, t0: ca.SX) -> None:
+        a.defect(x1.x - x0.x - h / 2 * (f(x0, t0) + f(x1, t0 + h)))  # x_k+1 − x_k = (h/2)(f_k + f_k+1)
 
     @staticmethod
-    def interpolate(x0: Node, x1: Node, xm: None, f: Rate, h: Any, s: Any) -> Local:
-        return Local(x=quadratic_state(x0.x, x1.x, f(x0), f(x1), h, s), u=x0.u + s * (x1.u - x0.u),
+    def interpolate(x0: Node, x1: Node, xm: None, f: Rate, h: Any, s: Any, t0: Any) -> Local:
+        return Local(x=quadratic_state(x0.x, x1.x, f(x0, t0), f(x1, t0 + h), h, s), u=x0.u + s * (x1.u - x0.u),
                      du_ds=x1.u - x0.u)
 
 

@@ -83,6 +83,23 @@ def test_a_free_parameter_is_optimized_and_end_rows_hold():
     assert certify(solution).passed
 
 
+@pytest.mark.parametrize("transcription", PSEUDOSPECTRAL + MESH)
+def test_time_dependent_dynamics(transcription):
+    """ẋ = t u, x(0) = 0, x(1) = 1, min ½∫u² dt: u = 3t, J* = 3/2 (λ = −3 constant); a path row reading t,
+    x ≤ t, holds along the optimum x = t³ and is imposed."""
+    ocp = Ocp(T=1.0)
+    x, u = ocp.state("x", start=0, end=1), ocp.control("u")
+    ocp.set_der(x, ocp.t * u)
+    ocp.subject_to(x - ocp.t, upper=0.0)
+    ocp.minimize_integral(0.5 * u ** 2)
+    solution = solve(ocp, transcription, 8 if transcription in PSEUDOSPECTRAL else 60)
+    exact = transcription in PSEUDOSPECTRAL
+    assert solution.converged and solution.objective == pytest.approx(1.5, rel=1e-8 if exact else 2e-3)
+    t = np.linspace(0.0, 1.0, 5)
+    np.testing.assert_allclose(solution.u("u", t), 3 * t, atol=1e-6 if exact else 0.05)
+    assert certify(solution).passed
+
+
 @pytest.mark.parametrize("transcription", ["lgr", "hermite-simpson"])
 def test_a_control_rate_bound_holds_and_lengthens_the_minimum_time(transcription):
     ocp = minimum_time()

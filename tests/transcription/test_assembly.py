@@ -26,8 +26,8 @@ def test_rows_through_the_point_functions_equal_the_constraints_own():
     assembly = Assembly(PROBLEM, make_dynamics("casadi-rnea", PROBLEM.robot), constraints)
     node, n = assembly.node("knot"), PROBLEM.robot.n
     slope, dt_ds = ca.SX.sym("du_ds", 2 * n), ca.SX.sym("dt_ds")  # du/dσ of the controls [q̈, u]
-    assembly.path(node, [slope], dt_ds)
-    values = assembly.point(node, slope, dt_ds)
+    assembly.path(node, [slope], dt_ds, None)  # the robot's values do not read t
+    values = assembly.point(node, slope, dt_ds, None)
     own = [constraint.evaluate(values, context) for constraint, context in zip(constraints, assembly.contexts)]
     assert len(assembly.g) == len(own) and sum(rows.g.numel() for rows in own) > 100
     collision = next(c for c in constraints if c.name == "collision")
