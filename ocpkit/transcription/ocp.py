@@ -191,9 +191,9 @@ class OCP(ABC):
 
 class ChainOCP(OCP):
     """An OCP whose states are a chain of two integrators x → ẋ (m values each) driven by the first m controls
-    ẍ: f = [ẋ, ẍ], time-invariant. Its chain samples carry x, ẋ, ẍ as the Samples' q, qd, qdd and the other controls and their
-    rates as tau, taud; its running input is the robot's jerk times dt/dσ (`jerk_s`), which the cost
-    t_f + μ ∫ q⃛ᵀ Q q⃛ dt integrates with Q = diag(1 / R²) (R the gear ratios, `Problem.jerk_weights`)."""
+    ẍ: f = [ẋ, ẍ], time-invariant. Its chain samples carry x, ẋ, ẍ as the Samples' q, qd, qdd and the other
+    controls and their rates as tau, taud; its running input is the robot's jerk times dt/dσ (`jerk_s`), which the
+    cost t_f + μ ∫ q⃛ᵀ Q q⃛ dt integrates with Q = diag(1 / R²) (R the gear ratios, `Problem.jerk_weights`)."""
 
     chain: int
     ends = 0
