@@ -46,7 +46,7 @@ class Certificate:
 
 def certify(solution: Solution, points: int = POINTS) -> Certificate:
     """The certificate of an ocpkit `solution` on `points` times in [0, t_f]."""
-    t = np.linspace(0.0, solution.T, points)
+    t = np.linspace(solution.t0, solution.T, points)
     x, u, du = solution.sample(t)
     return check(solution.model, t, x, u, du, lambda time: solution.sample(np.array([time]))[1][0])
 

@@ -22,14 +22,15 @@ import numpy as np
 from ocpkit.constraints import Constraint, Context, Rows
 from ocpkit.errors import OptionError
 from ocpkit.formats.trajectory import Samples, Trajectory
-from ocpkit.ocp.model import Ocp
+from ocpkit.ocp.model import Ocp, Row
 from ocpkit.problem import Problem
 from ocpkit.transcription.ocp import OCP, Node, PointFunction
 
 
 @dataclass(frozen=True)
 class ModelPoint:
-    """Scaled values at one point: x̃ (states + parameters, 1), ũ (controls, 1), du/dσ (controls, 1), dt/dσ, t (s)."""
+    """Scaled values at one point: x̃ (states + parameters, 1), ũ (controls, 1), du/dσ (controls, 1), dt/dσ and the
+    time since the start (s)."""
 
     x: ca.SX
     u: ca.SX
@@ -39,7 +40,7 @@ class ModelPoint:
 
 
 class ModelPath(Constraint):
-    """The Ocp's path rows that read no rate: lower ≤ h(x, u, p) ≤ upper at every point."""
+    """The Ocp's path rows that read no rate: lower ≤ h(x, u, p, t) ≤ upper at every point."""
 
     name = "path"
 
@@ -76,12 +77,14 @@ class ModelOCP(OCP):
         self.ends = self.states
         self.x_scale = np.concatenate([v.scale for v in held])
         self.u_scale = np.concatenate([v.scale for v in model.controls]) if model.controls else np.zeros(0)
+        # the transcription's time runs from 0 and its t_f is the duration T − t0: t = t0 + t_rel, T = t0 + D
         X, U, R, T, t = (ca.SX.sym("X", self.states), ca.SX.sym("U", self.controls),
-                         ca.SX.sym("R", self.controls), model.T, model.t)
+                         ca.SX.sym("R", self.controls), ca.SX.sym("D"), ca.SX.sym("t_rel"))
         real = [ca.vertcat(*(v.symbol for v in held)), ca.vertcat(*(v.symbol for v in model.controls)),
                 ca.vertcat(*(model.rate(v.symbol) for v in model.controls))]
         scaled = [ca.DM(self.x_scale) * X, ca.DM(self.u_scale) * U, ca.DM(self.u_scale) * R]
-        own = lambda expr: ca.substitute([ca.SX(expr)], real, scaled)[0]  # noqa: E731  in scaled symbols
+        clock = [model.t, model.T], [model.t0 + t, model.t0 + T]  # t0 is a parameter's symbol when free: two steps
+        own = lambda expr: ca.substitute([ca.substitute([ca.SX(expr)], *clock)[0]], real, scaled)[0]  # noqa: E731
 
         rhs = ca.vertcat(*(model.derivatives[v.name] for v in model.states), ca.SX.zeros(self.states - sum(
             v.size for v in model.states)))
@@ -98,20 +101,29 @@ class ModelOCP(OCP):
         self._running = self._function("running", [X, U, R, t], own(model.lagrange), "minimize_integral", [T])
         self._mayer = self._function("mayer", [X, T], own(model.mayer), "minimize_end", [U, R, t])
         self._start = self._function("start", [X], rows(model.start), "at_start", [U, R, T, t])
-        self._end = self._function("end", [X, T], rows(model.end), "at_end", [U, R, t])
-        self._start_bounds, self._end_bounds = bounds(model.start), bounds(model.end)
+        ends = model.end + self._final_time_rows()
+        self._end = self._function("end", [X, T], rows(ends), "at_end", [U, R, t])
+        self._start_bounds, self._end_bounds = bounds(model.start), bounds(ends)
+
+    def _final_time_rows(self) -> list[Row]:
+        """With a free initial time, T = t0 + D within its bounds as an end row (else the bounds of D say it)."""
+        model = self.model
+        if model.t0_bounds[0] == model.t0_bounds[1]:
+            return []
+        lower, upper = (model.T_fixed,) * 2 if model.T_fixed is not None else model.T_bounds
+        return [Row(ca.SX(model.T), np.array([lower]), np.array([upper]))]
 
     def _function(self, name: str, inputs: list[ca.SX], output: ca.SX, what: str, barred: list[ca.SX]) -> ca.Function:
         """ca.Function of `inputs`; OptionError naming the Ocp call `what` if `output` reads a `barred` symbol or one
         the Ocp never declared."""
         if any(ca.depends_on(output, symbol) for symbol in barred if symbol.numel()):
             raise OptionError(f"{self.model.name}: {what} reads a symbol it cannot (states, controls, rates, "
-                              "parameters and T each have their place: see ocpkit.ocp.model)")
+                              "parameters, t and T each have their place: see ocpkit.ocp.model)")
         try:
             return ca.Function(name, inputs, [output])
         except RuntimeError as exc:
             raise OptionError(f"{self.model.name}: {what} reads a symbol that is not a declared state, control, "
-                              f"parameter or T: {str(exc).splitlines()[-1]}") from None
+                              f"parameter, t or T: {str(exc).splitlines()[-1]}") from None
 
     @property
     def key(self) -> tuple:
@@ -153,8 +165,10 @@ class ModelOCP(OCP):
                 a.add(Rows(expr, lower, upper))
 
     def time_bounds(self, problem: Problem | None) -> tuple[float, float]:
-        fixed = self.model.T_fixed
-        return (fixed, fixed) if fixed is not None else self.model.T_bounds
+        """(lower, upper) of the duration T − t0 (s), the transcription's t_f."""
+        model, (first, last) = self.model, self.model.t0_bounds
+        lower, upper = (model.T_fixed,) * 2 if model.T_fixed is not None else model.T_bounds
+        return max(lower - last, 0.0), upper - first
 
     def end_bounds(self, problem: Problem | None) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
         """Fixed start and end values where given, the variables' bounds elsewhere (scaled)."""
@@ -170,10 +184,11 @@ class ModelOCP(OCP):
         return {v.name: (v.lower / v.scale, v.upper / v.scale) for v in self.model.variables}
 
     def guess(self, problem: Problem | None) -> Trajectory:
-        """Each state on the line from its start to its end value (fixed ones, else its guess) over T_guess, or its
-        guess function of τ = t/T_guess; the parameters and controls at their guesses (scaled)."""
-        model, T = self.model, self.model.T_guess
-        held = [*model.states, *model.parameters]
+        """Each state on the line from its start to its end value (fixed ones, else its guess) over the guessed
+        duration, or its guess function of τ = (t − t0)/(T − t0); the parameters and controls at their guesses
+        (scaled)."""
+        model = self.model
+        T, held = model.T_guess - model.t0_guess, [*model.states, *model.parameters]
 
         def values(variables: list, t: np.ndarray) -> np.ndarray:
             columns = [v.guess_at(t / T) / v.scale for v in variables]

@@ -27,7 +27,7 @@ from ocpkit.errors import OptionError
 INF = float("inf")
 Guess = float | list | Callable[[np.ndarray], np.ndarray] | None
 """A variable's guess: a value (one or `size` numbers), a function of τ = t/t_f ∈ [0, 1], or None (a default)."""
-RESERVED = re.compile(r"(X|M|E|tf|start|goal|check_at|mu|margin|limit_scale|(knot|mid|end|tf)\d+)")
+RESERVED = re.compile(r"(X|M|E|tf|t0|start|goal|check_at|mu|margin|limit_scale|(knot|mid|end|tf)\d+)")
 """Names the transcriptions give parts of the NLP's vectors themselves."""
 
 
@@ -71,10 +71,11 @@ class Row:
 
 class Ocp:
     """An optimal control problem under construction (module docstring). `T` fixes t_f (s); without it t_f is
-    free in `T_bounds` and starts from `T_guess`."""
+    free in `T_bounds` and starts from `T_guess`. `t0` is the initial time (s): a number, or (lower, upper) for a
+    free one, then the parameter "t0" (its guess `t0_guess`, else the middle of its bounds)."""
 
     def __init__(self, T: float | None = None, T_bounds: tuple[float, float] = (0.0, INF), T_guess: float | None = None,
-                 name: str = "ocp") -> None:
+                 name: str = "ocp", t0: float | tuple[float, float] = 0.0, t0_guess: float | None = None) -> None:
         if T is not None and not T > 0:
             raise OptionError(f"{name}: T must be > 0 (s), got {T}")
         lower, upper = map(float, T_bounds)
@@ -89,6 +90,13 @@ class Ocp:
         self._T = ca.SX.sym("T")
         self._t = ca.SX.sym("t")
         self._rates: dict[str, ca.SX] = {}
+        self.t0_bounds = _t0_bounds(t0, name)
+        free = self.t0_bounds[0] < self.t0_bounds[1]
+        self._t0 = self._declare(self.parameters, "t0", 1, *self.t0_bounds, None, None, t0_guess, 1.0) if free \
+            else ca.SX(self.t0_bounds[0])
+        self.t0_guess = float(t0_guess if t0_guess is not None else np.mean(self.t0_bounds))
+        if not self.T_guess > self.t0_guess:
+            raise OptionError(f"{name}: T_guess must be after t0's guess, got {self.T_guess} and {self.t0_guess}")
 
     # -- declarations ----------------------------------------------------------------------------------
     def state(self, name: str, size: int = 1, lower: float | list = -INF, upper: float | list = INF,
@@ -98,24 +106,28 @@ class Ocp:
         (a value, or a function of the normalized time τ = t/t_f (points,) ↦ (points,) or (points, size); by
         default the line from the start to the end value where they are fixed, else the middle of finite bounds,
         else 0) and a scale."""
-        return self._declare(self.states, name, size, lower, upper, start, end, guess, scale)
+        return self._declare(self.states, self._free(name), size, lower, upper, start, end, guess, scale)
 
     def control(self, name: str, size: int = 1, lower: float | list = -INF, upper: float | list = INF,
                 guess: Guess = None, scale: float | list = 1.0) -> ca.SX:
         """A control u (size, 1) with bounds, guess and scale; the transcription interpolates it as its own
         polynomial, so `rate(u)` is defined."""
-        return self._declare(self.controls, name, size, lower, upper, None, None, guess, scale)
+        return self._declare(self.controls, self._free(name), size, lower, upper, None, None, guess, scale)
 
     def parameter(self, name: str, size: int = 1, lower: float | list = -INF, upper: float | list = INF,
                   guess: float | list | None = None, scale: float | list = 1.0) -> ca.SX:
         """A parameter p (size, 1), constant in time and optimized within its bounds."""
-        return self._declare(self.parameters, name, size, lower, upper, None, None, guess, scale)
+        return self._declare(self.parameters, self._free(name), size, lower, upper, None, None, guess, scale)
+
+    def _free(self, name: str) -> str:
+        """`name` if a user's variable may have it; OptionError otherwise."""
+        if not name.isidentifier() or RESERVED.fullmatch(name):
+            raise OptionError(f"{self.name}: {name!r} cannot name a variable (an identifier, not one of the NLP's "
+                              "own names X, M, E, tf, t0, start, goal, knot0, ...)")
+        return name
 
     def _declare(self, family: list[Variable], name: str, size: int, lower, upper, start, end, guess,
                  scale) -> ca.SX:
-        if not name.isidentifier() or RESERVED.fullmatch(name):
-            raise OptionError(f"{self.name}: {name!r} cannot name a variable (an identifier, not one of the NLP's "
-                              "own names X, M, E, tf, start, goal, knot0, ...)")
         if name in {v.name for v in self.variables}:
             raise OptionError(f"{self.name}: a variable named {name!r} is already declared")
         if size < 1:
@@ -144,6 +156,11 @@ class Ocp:
     @property
     def variables(self) -> list[Variable]:
         return [*self.states, *self.controls, *self.parameters]
+
+    @property
+    def t0(self) -> ca.SX:
+        """The initial time (s): the parameter "t0" when free, else its value; readable wherever `T` is."""
+        return self._t0
 
     @property
     def t(self) -> ca.SX:
@@ -224,6 +241,14 @@ class Ocp:
         if expr.numel() != 1:
             raise OptionError(f"{self.name}: {what} takes a scalar, got {expr.numel()} values")
         return expr
+
+
+def _t0_bounds(t0: float | tuple[float, float], name: str) -> tuple[float, float]:
+    """(lower, upper) of the initial time: equal for a fixed one; OptionError unless finite and ordered."""
+    bounds = np.asarray(t0, dtype=float).ravel()
+    if bounds.size not in (1, 2) or not np.all(np.isfinite(bounds)) or bounds[0] > bounds[-1]:
+        raise OptionError(f"{name}: t0 must be a number or (lower, upper) with lower ≤ upper, got {t0}")
+    return float(bounds[0]), float(bounds[-1])
 
 
 def _vector(value, size: int, what: str) -> np.ndarray:

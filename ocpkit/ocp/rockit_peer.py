@@ -58,6 +58,8 @@ class PeerResult:
 def solve_with_rockit(ocp: Ocp, method: str = "multiple-shooting", intervals: int = 50) -> PeerResult:
     """Solve `ocp` with rockit's `method` ("multiple-shooting": one RK4 step per interval; "direct-collocation":
     Radau, degree 4) on `intervals` uniform control intervals (module docstring for the translation)."""
+    if ocp.t0_bounds != (0.0, 0.0):
+        raise OptionError(f"{ocp.name}: the rockit peer translates problems that start at t = 0 only")
     if method not in METHODS:
         raise OptionError(f"{ocp.name}: unknown rockit method {method!r}; known: {', '.join(METHODS)}")
     if intervals < 1:

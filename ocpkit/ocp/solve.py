@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ocpkit.formats.trajectory import Trajectory
+from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.ocp.instance import ModelOCP
 from ocpkit.ocp.model import Ocp
 from ocpkit.registry import construct
@@ -55,9 +55,15 @@ class Solution:
         return self.result.wall_time
 
     @property
+    def t0(self) -> float:
+        """The initial time (s)."""
+        first, last = self.model.t0_bounds
+        return first if first == last else self.p("t0")
+
+    @property
     def T(self) -> float:
         """t_f (s)."""
-        return self.trajectory.tf
+        return self.t0 + self.trajectory.tf
 
     @functools.cached_property
     def trajectory(self) -> Trajectory:
@@ -67,12 +73,17 @@ class Solution:
     @property
     def knot_times(self) -> np.ndarray:
         """The transcription's knot times (s), increasing."""
-        return self.trajectory.knots.t
+        return self.t0 + self.trajectory.knots.t
 
     def sample(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(x (points, states + parameters), u (points, controls), u̇ (points, controls)) at times t, user units."""
-        s = self.trajectory.interpolant(np.atleast_1d(np.asarray(t, dtype=float)))
+        """(x (points, states + parameters), u (points, controls), u̇ (points, controls)) at times t ∈ [t0, t_f]
+        (s), user units."""
+        s = self._relative(np.atleast_1d(np.asarray(t, dtype=float)) - self.t0)
         return s.q * self.ocp.x_scale, s.tau * self.ocp.u_scale, s.taud * self.ocp.u_scale
+
+    def _relative(self, t: np.ndarray) -> Samples:
+        """The decoded trajectory at times since the start t (s)."""
+        return self.trajectory.interpolant(t)
 
     def x(self, name: str, t: np.ndarray) -> np.ndarray:
         """State `name` at times t: (points,) for a scalar, else (points, size)."""
@@ -83,8 +94,9 @@ class Solution:
         return self._part(name, self.sample(t)[1], self.model.controls)
 
     def p(self, name: str) -> float | np.ndarray:
-        """Parameter `name`'s optimal value."""
-        value = self._part(name, self.sample(np.zeros(1))[0], [*self.model.states, *self.model.parameters])
+        """Parameter `name`'s optimal value ("t0" for a free initial time)."""
+        s = self._relative(np.zeros(1))
+        value = self._part(name, s.q * self.ocp.x_scale, [*self.model.states, *self.model.parameters])
         return float(value[0]) if np.ndim(value) == 1 else value[0]
 
     def _part(self, name: str, values: np.ndarray, family: list) -> np.ndarray:
@@ -111,7 +123,7 @@ class Solution:
         for j, first, weight in rows:
             multipliers[j] += self.result.lam_g[first:first + self.ocp.states]
             weights[j] += weight
-        t = self.T * (grid.knots[columns] + 1.0) / 2.0
+        t = self.t0 + self.trajectory.tf * (grid.knots[columns] + 1.0) / 2.0
         lam = -np.stack([multipliers[j] / weights[j] for j in columns]) / self.ocp.x_scale
         order = np.argsort(t)
         return t[order], lam[order]

@@ -58,3 +58,9 @@ def test_a_rate_in_the_dynamics_is_refused():
 def test_bad_final_times_are_refused(T, bounds):
     with pytest.raises(OptionError, match="T"):
         Ocp(T=T, T_bounds=bounds)
+
+
+@pytest.mark.parametrize("t0", [(2.0, 1.0), (0.0, float("inf")), (1.0, 2.0, 3.0)])
+def test_bad_initial_times_are_refused(t0):
+    with pytest.raises(OptionError, match="t0 must be a number or"):
+        Ocp(T=5.0, t0=t0)

@@ -139,3 +139,30 @@ def test_the_certificate_sees_a_corrupted_control():
                             solution.objective, solution.transcription, solution.knots)
     certificate = certify(broken)
     assert not certificate.passed and certificate.state_error > 0.1
+
+
+def test_a_fixed_initial_time_other_than_zero():
+    """ẋ = t u on [1, 3], x(1) = 0, x(3) = 1, min ½∫u² dt: u = 3t/26 (λ = −3/26), J* = ½ (3/26)² 26/3 = 39/676."""
+    ocp = Ocp(T=3.0, t0=1.0)
+    x, u = ocp.state("x", start=0, end=1), ocp.control("u")
+    ocp.set_der(x, ocp.t * u)
+    ocp.minimize_integral(0.5 * u ** 2)
+    solution = solve(ocp, "lgr", 8)
+    assert solution.t0 == 1.0 and solution.T == pytest.approx(3.0)
+    assert solution.objective == pytest.approx(39 / 676, rel=1e-8)
+    np.testing.assert_allclose(solution.u("u", np.array([1.0, 2.0, 3.0])), 3 * np.array([1.0, 2.0, 3.0]) / 26,
+                               atol=1e-7)
+    assert certify(solution).passed
+
+
+@pytest.mark.parametrize("transcription", ["chebyshev", "hermite-simpson"])
+def test_a_free_initial_time(transcription):
+    """ẋ = u, |u| ≤ 1, x(t0) = 0, x(3) = 1, t0 ∈ [0, 2.5], start as late as possible: t0* = 2 (one second at full
+    speed)."""
+    ocp = Ocp(T=3.0, t0=(0.0, 2.5))
+    x, u = ocp.state("x", start=0, end=1), ocp.control("u", lower=-1, upper=1)
+    ocp.set_der(x, u)
+    ocp.minimize_end(-ocp.t0)
+    solution = solve(ocp, transcription, 20)
+    assert solution.converged and solution.t0 == pytest.approx(2.0, abs=1e-6) and solution.T == pytest.approx(3.0)
+    assert certify(solution).passed
