@@ -23,8 +23,8 @@ from ocpkit.constraints import Constraint
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.problem import Problem
 
-SCREEN_DISTANCE = 0.1  # m: a term is kept when its clearance is below this somewhere near the motion
-MISSING_DISTANCE = 0.05  # m: a left-out term this close to an unverified plan's motion triggers a rebuild
+SCREEN_DISTANCE = 0.2  # m: a term is kept when its clearance is below this somewhere near the motion
+MISSING_DISTANCE = 0.1  # m: a left-out term this close to an unverified plan's motion triggers a rebuild
 MAX_REBUILDS = 3
 SAMPLES = 64  # configurations sampled along a motion (evenly in time)
 
