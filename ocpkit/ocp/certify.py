@@ -19,7 +19,7 @@ import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ocpkit.ocp.model import Ocp, Variable
+from ocpkit.ocp.model import Ocp, columns, stacked
 from ocpkit.ocp.rockit_peer import PeerResult
 from ocpkit.ocp.solve import Solution
 
@@ -68,19 +68,19 @@ def check(model: Ocp, t: np.ndarray, x: np.ndarray, u: np.ndarray, du: np.ndarra
     """The certificate of a solution of `model` given at times t (points,) as x (points, states + parameters), u and
     u̇ (points, controls), with `control` its control at any time (user units)."""
     held = [*model.states, *model.parameters]
-    rate = ca.Function("rate", [_stack(held), _stack(model.controls), model.t], [ca.vertcat(
+    rate = ca.Function("rate", [stacked([v.symbol for v in held]), stacked([v.symbol for v in model.controls]),
+                                model.t], [ca.vertcat(
         *(model.derivatives[v.name] for v in model.states), ca.DM.zeros(sum(v.size for v in model.parameters)))])
     rhs = lambda time, state: np.asarray(rate(state, control(time), time)).ravel()  # noqa: E731
     integrated = solve_ivp(rhs, (t[0], t[-1]), x[0], method="LSODA", t_eval=t, rtol=rtol, atol=atol)
     error = np.abs(integrated.y.T - x) if integrated.success else np.full_like(x, np.inf)
     state_error = float(np.max(error / (1.0 + np.max(np.abs(x), axis=0))))
 
-    values = {v.name: block for v, block in zip((*held, *model.controls), (*_columns(held, x),
-                                                                           *_columns(model.controls, u)))}
+    values = {**columns(held, x), **columns(model.controls, u)}
     excesses = {f"bound of {v.name}": _excess(values[v.name], v.lower, v.upper) for v in model.variables}
     real = [v.symbol for v in model.variables]
     rates = [model.rate(v.symbol) for v in model.controls]
-    arguments = [values[v.name] for v in model.variables] + list(_columns(model.controls, du))
+    arguments = [values[v.name] for v in model.variables] + list(columns(model.controls, du).values())
     for number, row in enumerate(model.path):
         function = ca.Function("row", [*real, *rates, model.t], [row.expr])
         rows = np.asarray(function.map(len(t))(*(a.T for a in arguments), t[None, :])).T
@@ -93,16 +93,6 @@ def check(model: Ocp, t: np.ndarray, x: np.ndarray, u: np.ndarray, du: np.ndarra
     worst = max(excesses, key=excesses.get)
     return Certificate(state_error, float(np.max(error)), excesses[worst], worst,
                        state_error <= STATE_TOLERANCE and excesses[worst] <= PATH_TOLERANCE)
-
-
-def _stack(variables: list[Variable]) -> ca.SX:
-    return ca.vertcat(*(v.symbol for v in variables)) if variables else ca.SX(0, 1)
-
-
-def _columns(variables: list[Variable], values: np.ndarray) -> list[np.ndarray]:
-    """Each variable's columns (points, size) of `values`, whose columns follow `variables`."""
-    edges = np.cumsum([0, *(v.size for v in variables)])
-    return [values[:, a:b] for a, b in zip(edges[:-1], edges[1:])]
 
 
 def _excess(values: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> float:

@@ -11,7 +11,6 @@ calls it at each point; no check points are lifted between knots (`check_parts` 
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -88,6 +87,7 @@ class ModelOCP(OCP):
 
         rhs = ca.vertcat(*(model.derivatives[v.name] for v in model.states), ca.SX.zeros(self.states - sum(
             v.size for v in model.states)))
+        self._maps: dict[int, ca.Function] = {}
         self._f = self._function("dynamics", [X, U, t], own(rhs) / ca.DM(self.x_scale), "set_der", [R, T])
         rows = lambda found: ca.vertcat(*(own(r.expr) for r in found))  # noqa: E731
         bounds = lambda found: (np.concatenate([r.lower for r in found] or [np.zeros(0)]),  # noqa: E731
@@ -132,13 +132,10 @@ class ModelOCP(OCP):
     def rate(self, x: Node, t: Any) -> Any:
         if isinstance(x.x, np.ndarray):
             times = np.broadcast_to(np.asarray(t, dtype=float).ravel(), (len(x.x),))[None, :]
-            return np.asarray(self._mapped(len(x.x))(x.x.T, x.u.T, times)).T.reshape(x.x.shape)
+            if len(x.x) not in self._maps:  # f over that many nodes at once, made once
+                self._maps[len(x.x)] = self._f.map(len(x.x))
+            return np.asarray(self._maps[len(x.x)](x.x.T, x.u.T, times)).T.reshape(x.x.shape)
         return self._f(x.x, x.u, t)
-
-    @functools.lru_cache(maxsize=8)  # noqa: B019  (one instance per solve; the maps are small)
-    def _mapped(self, points: int) -> ca.Function:
-        """f over `points` nodes at once."""
-        return self._f.map(points)
 
     def point_values(self, dynamics: Any) -> PointFunction:
         return lambda x, du_ds, dt_ds, t: ModelPoint(x.x, x.u, du_ds, dt_ds, t)

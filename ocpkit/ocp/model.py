@@ -243,6 +243,17 @@ class Ocp:
         return expr
 
 
+def stacked(symbols: list[ca.SX]) -> ca.SX:
+    """The symbols one above the other (a column; (0, 1) for none)."""
+    return ca.vertcat(*symbols) if symbols else ca.SX(0, 1)
+
+
+def columns(variables: list[Variable], values: np.ndarray) -> dict[str, np.ndarray]:
+    """Variable name → its columns (points, size) of `values` (points, Σ sizes), whose columns follow `variables`."""
+    edges = np.cumsum([0, *(v.size for v in variables)])
+    return {v.name: values[:, a:b] for v, a, b in zip(variables, edges[:-1], edges[1:])}
+
+
 def _t0_bounds(t0: float | tuple[float, float], name: str) -> tuple[float, float]:
     """(lower, upper) of the initial time: equal for a fixed one; OptionError unless finite and ordered."""
     bounds = np.asarray(t0, dtype=float).ravel()

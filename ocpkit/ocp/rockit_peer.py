@@ -27,7 +27,7 @@ import casadi as ca
 import numpy as np
 
 from ocpkit.errors import OptionError
-from ocpkit.ocp.model import Ocp
+from ocpkit.ocp.model import Ocp, stacked
 
 METHODS = ("multiple-shooting", "direct-collocation")
 IPOPT_OPTIONS = {"expand": True, "print_time": False, "ipopt.print_level": 0, "ipopt.sb": "yes"}
@@ -131,8 +131,8 @@ def solve_with_rockit(ocp: Ocp, method: str = "multiple-shooting", intervals: in
 def _caller(ocp: Ocp, states: list, controls: list, parameters: list, T: ca.MX, rates: list, t: ca.MX):
     """A function: expr (SX of the `Ocp`'s symbols) → the same expression on rockit's MX symbols."""
     rate_symbols = [ocp.rates[v.name] for v in ocp.controls if v.name in ocp.rates]
-    sx = [_stack([v.symbol for v in family]) for family in (ocp.states, ocp.controls, ocp.parameters)]
-    sx += [ocp.T, _stack(rate_symbols), ocp.t]
+    sx = [stacked([v.symbol for v in family]) for family in (ocp.states, ocp.controls, ocp.parameters)]
+    sx += [ocp.T, stacked(rate_symbols), ocp.t]
     mx = [ca.vertcat(*family) if family else ca.MX(0, 1) for family in (states, controls, parameters)]
     mx += [T, ca.vertcat(*rates) if rates else ca.MX(0, 1), t]
 
@@ -148,10 +148,6 @@ def _initial(variable, tau: ca.MX) -> ca.MX:
     grid = np.linspace(0.0, 1.0, 101)
     table = ca.interpolant(f"guess_{variable.name}", "linear", [grid], variable.guess_at(grid).ravel())
     return table(tau)
-
-
-def _stack(symbols: list[ca.SX]) -> ca.SX:
-    return ca.vertcat(*symbols) if symbols else ca.SX(0, 1)
 
 
 def _column(values: np.ndarray) -> ca.DM:

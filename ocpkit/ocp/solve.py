@@ -12,7 +12,7 @@ import numpy as np
 
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.ocp.instance import ModelOCP
-from ocpkit.ocp.model import Ocp
+from ocpkit.ocp.model import Ocp, columns
 from ocpkit.registry import construct
 from ocpkit.solvers import SOLVERS, SolverResult
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
@@ -100,13 +100,10 @@ class Solution:
         return float(value[0]) if np.ndim(value) == 1 else value[0]
 
     def _part(self, name: str, values: np.ndarray, family: list) -> np.ndarray:
-        start = 0
-        for variable in family:
-            if variable.name == name:
-                part = values[:, start:start + variable.size]
-                return part[:, 0] if variable.size == 1 else part
-            start += variable.size
-        raise KeyError(f"{self.model.name} has no {name!r} here: {[v.name for v in family]}")
+        parts = columns(family, values)
+        if name not in parts:
+            raise KeyError(f"{self.model.name} has no {name!r} here: {list(parts)}")
+        return parts[name][:, 0] if parts[name].shape[1] == 1 else parts[name]
 
     def costates(self) -> tuple[np.ndarray, np.ndarray]:
         """(t (points,), λ (points, states + parameters)) at the collocated knots, in the user's units, estimated
