@@ -55,6 +55,12 @@ class Solution:
         return self.result.wall_time
 
     @property
+    def segments(self) -> int:
+        """The pseudospectral segments (1 for the mesh transcriptions)."""
+        grid = getattr(self.discretization, "grid", None)
+        return grid.K if grid is not None else 1
+
+    @property
     def t0(self) -> float:
         """The initial time (s)."""
         first, last = self.model.t0_bounds
@@ -127,9 +133,11 @@ class Solution:
 
 
 def solve(model: Ocp, transcription: str = "chebyshev", knots: int = 30, solver: str = "ipopt",
-          transcription_options: dict | None = None, solver_options: dict | None = None) -> Solution:
+          transcription_options: dict | None = None, solver_options: dict | None = None,
+          start: Solution | None = None) -> Solution:
     """Discretize `model` with the transcription `transcription` (`ocpkit list`; its options, e.g. segments, in
-    `transcription_options`) at `knots` and solve it with `solver` from the model's guess."""
+    `transcription_options`) at `knots` and solve it with `solver` from the model's guess, or from the solution
+    `start` of the same model (any transcription or grid) sampled at the new knots."""
     began = time.perf_counter()
     ocp = ModelOCP(model)
     method = construct(TRANSCRIPTIONS.get(transcription), transcription,
@@ -140,7 +148,8 @@ def solve(model: Ocp, transcription: str = "chebyshev", knots: int = 30, solver:
     prepared = construct(SOLVERS.get(solver), solver, options).prepare(nlp)
     setup_time = time.perf_counter() - began
     bounds, parameters = discretization.bounds(None), discretization.parameters(None)
-    guess = np.clip(discretization.initial_guess(None), *bounds)
+    guess = discretization.initial_guess(None) if start is None else discretization.encode(start.trajectory)
+    guess = np.clip(guess, *bounds)
     result = prepared.solve(guess, parameters, bounds)
     objective = float(ca.Function("f", [nlp.x, nlp.p], [nlp.f])(result.w, parameters))
     return Solution(model, ocp, discretization, result, objective, transcription, knots, setup_time)

@@ -14,6 +14,7 @@ from numpy.polynomial import Legendre, Polynomial
 import ocpkit
 from ocpkit.constraints import make_constraints
 from ocpkit.dynamics import make_dynamics
+from ocpkit.errors import OptionError
 from ocpkit.nlp import Refinement
 from ocpkit.transcription.chebyshev import Chebyshev
 from ocpkit.transcription.lgl import LGL, LegendreGaussLobatto, lgl_points, lgl_weights
@@ -236,3 +237,41 @@ def test_paper_case_is_verified(name, case):
     result = ocpkit.plan(problem, transcription=name, knots=knots, transcription_options={"segments": segments})
     assert result.status == "verified", result.verification.summary()
     assert problem.velocity_lower_bound() < result.trajectory.tf < 3.0
+
+
+@pytest.mark.parametrize("family", [CHEBYSHEV, LGL], ids=lambda f: f.name)
+def test_unequal_segments_end_at_their_breaks_and_interpolate_exactly(family):
+    grid = Grid(family, N, 3, breaks=(0.2, 0.9))  # segments of 0.2, 0.7 and 0.1 of the horizon
+    knots = grid.knots
+    np.testing.assert_allclose(knots[[0, N, 2 * N, 3 * N]], [1.0, 0.8, -0.6, -1.0], atol=1e-15)
+    assert np.all(np.diff(knots) < 0)
+    np.testing.assert_allclose(grid.scale(np.arange(3)), [2 / 0.2, 2 / 1.4, 2 / 0.4])
+    smooth, x = random_polynomial(N), np.linspace(-1, 1, 61)
+    L, Ld = grid.matrices(x)
+    np.testing.assert_allclose(L @ smooth(knots), smooth(x), atol=1e-10 * np.abs(smooth.coef).sum())
+    ds_dsigma = grid.scale(grid.segment_of(x))  # d/ds on each point's own segment
+    np.testing.assert_allclose(Ld @ smooth(knots), smooth.deriv()(x) / ds_dsigma, atol=1e-9 * np.abs(smooth.coef).sum())
+    np.testing.assert_array_equal(grid.segment_of(np.array([0.9, 0.8, 0.0, -0.6, -0.7])), [0, 1, 1, 2, 2])
+
+
+def test_equal_segments_keep_their_closed_form():
+    equal = Grid(CHEBYSHEV, N, 3)
+    assert equal.scale(1) == 3 and not equal.breaks
+    np.testing.assert_allclose(Grid(CHEBYSHEV, N, 3, breaks=(1 / 3, 2 / 3)).knots, equal.knots, atol=1e-15)
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"breaks": (0.5, 0.3)}, "increase strictly"),
+    ({"breaks": (0.0, 0.5)}, "increase strictly"),
+    ({"breaks": (0.5, 1.0)}, "increase strictly"),
+    ({"breaks": (0.5,), "segments": 3}, "disagrees"),
+    ({"knots": 65}, "per segment"),
+])
+def test_bad_breaks_and_knots_are_refused_by_name(options, message):
+    with pytest.raises(OptionError, match=message):
+        Chebyshev(**{"knots": 8, **options})
+
+
+def test_a_robot_refuses_breaks():
+    with pytest.raises(OptionError, match="breaks are for"):
+        discretize(PROBLEM, "chebyshev", knots=N, breaks=(0.5,))
