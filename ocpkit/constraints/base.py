@@ -99,6 +99,9 @@ class Constraint(ABC):
         """Rows per point that `screened` may leave out; 0 for a constraint that screens nothing."""
         return 0
 
+    screened_at: float = 0.0
+    """The distance (its own unit) `screened` kept its rows within; 0 when it was not screened."""
+
     def screened(self, problem: Problem, near: np.ndarray, distance: float) -> Constraint:
         """This constraint for `problem` without the rows that stay inactive by more than `distance` (its own unit)
         at every configuration of `near` (K, n) (ocpkit.planner.screening); itself when it has nothing to leave out."""

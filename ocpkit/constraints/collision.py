@@ -115,6 +115,7 @@ class SphereCollision(Constraint):
         kept = copy.copy(self)
         kept.pair_mask, kept.obstacle_mask, kept.face_mask = (mask & near_ for mask, near_ in zip(
             (self.pair_mask, self.obstacle_mask, self.face_mask), close))
+        kept.screened_at = distance
         return kept
 
     def missing(self, problem: Problem, near: np.ndarray, distance: float) -> int:

@@ -28,7 +28,7 @@ import psutil
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics, make_dynamics
 from ocpkit.errors import OptionError
-from ocpkit.planner.screening import SCREEN_DISTANCE
+from ocpkit.planner.screening import screened
 from ocpkit.problem import Problem
 from ocpkit.registry import construct
 from ocpkit.solvers import SOLVERS, PreparedSolver
@@ -72,7 +72,7 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     transcription_options = _staged_for(solver, options, transcription, transcription_options or {})
     method = construct(TRANSCRIPTIONS.get(transcription), transcription, {"knots": knots, **transcription_options})
     backend = make_dynamics(dynamics, problem.robot, **(dynamics_options or {}))
-    plugins = make_constraints(problem, constraints, None if near is None else (near, SCREEN_DISTANCE))
+    plugins = make_constraints(problem, constraints) if near is None else screened(problem, constraints, near)
     nlp_solver = construct(SOLVERS.get(solver), solver, options)  # a wrong name or option fails before a build
     key = (method.shape_key(backend, plugins, ocp), solver, frozen(options))
     if key in _BUILDS:

@@ -12,7 +12,8 @@ from ocpkit.constraints.collision import SphereCollision
 from ocpkit.formats.scenario import load_scenario
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
 from ocpkit.planner.options import SimultaneousOptions
-from ocpkit.planner.screening import line_samples, worth_screening
+from ocpkit.planner.screening import (CROWDED_DISTANCE, CROWDED_ROWS, SCREEN_DISTANCE, line_samples, missing,
+                                     screenable_rows, screened, worth_screening)
 from ocpkit.planner.simultaneous import END_CHECK_CLEARANCE, _checked_near_the_ends, plan_simultaneous
 from ocpkit.transcription.pseudospectral import long_interval_midpoints
 from tests.helpers import REPO
@@ -43,6 +44,22 @@ def test_missing_counts_the_left_out_terms_near_other_configurations():
     c = clearances(PANDA.robot, PANDA.scene, sphere_centers_batch(PANDA.robot, elsewhere))
     close = (c.self_pairs.min(axis=0) < 0.1) & kept.pair_mask.__invert__() & SphereCollision(PANDA).pair_mask
     assert kept.missing(PANDA, elsewhere, 0.1) >= close.sum() > 0
+
+
+def test_a_crowded_nlp_is_screened_tighter_and_rebuilt_sooner():
+    near = line_samples(PANDA)
+    wide = screenable_rows(make_constraints(PANDA, screen=(near, SCREEN_DISTANCE)))
+    assert wide > CROWDED_ROWS  # an MBM Panda problem keeps hundreds of terms a point at 0.2 m
+    crowded = screened(PANDA, ("collision",), near)
+    assert crowded[0].screened_at == CROWDED_DISTANCE
+    assert crowded[0].term_count == SphereCollision(PANDA).screened(PANDA, near, CROWDED_DISTANCE).term_count < wide
+    sparse = screened(PAPER, ("collision",), line_samples(PAPER))
+    assert sparse[0].screened_at == SCREEN_DISTANCE  # the paper's cases keep a handful: the wide screen
+    assert screenable_rows(sparse) <= CROWDED_ROWS
+    rng = np.random.default_rng(0)
+    elsewhere = rng.uniform(PANDA.robot.q_lower, PANDA.robot.q_upper, (50, PANDA.robot.n))
+    assert missing(PANDA, crowded, elsewhere) == crowded[0].missing(PANDA, elsewhere, CROWDED_DISTANCE / 2) > 0
+    assert missing(PANDA, crowded, near) == 0
 
 
 def test_constraints_with_any_collision_terms_are_worth_screening():
