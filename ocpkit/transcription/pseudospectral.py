@@ -17,8 +17,8 @@ also imposed between knots".
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import casadi as ca
@@ -58,7 +58,7 @@ class Grid:
     def scale(self, segment: int | np.ndarray) -> float | np.ndarray:
         """K_b = ds/dσ of segment b: K on equal segments, 2 / its σ-length otherwise."""
         if not self.breaks:
-            return self.K + 0 * np.asarray(segment) if np.ndim(segment) else self.K
+            return np.full(np.shape(segment), self.K) if np.ndim(segment) else self.K
         return 2.0 / (self._edges[segment] - self._edges[np.asarray(segment) + 1])
 
     def to_global(self, segment: int | np.ndarray, s: np.ndarray) -> np.ndarray:
