@@ -1,14 +1,22 @@
-"""Legendre–Gauss–Radau (LGR) pseudospectral transcription (`lgr`): a node family for pseudospectral.py, flipped
-as in GPOPS-II and dymos so that the start (s = −1) is collocated and the end (s = +1, t_f) is not.
+"""Legendre–Gauss–Radau (LGR) pseudospectral transcription (`lgr`): two node families for pseudospectral.py,
+N Radau points and one point that is not collocated.
 
-    D X = h F at every point but t_f;  dynamics residual and path constraints at every point, t_f included
+    LGR         the end of each segment collocated, its start not (Radau IIA; option collocate="end", default)
+    LGR_START   the start collocated, the end not (GPOPS-II's and dymos' orientation; collocate="start")
+    D X = h F at every collocated point;  dynamics residual and path constraints at every point
+
+Why the end by default: collocation at Radau points that include a segment's end is L-stable (its stability
+function is the (N−1, N) Padé approximant of e^z, which vanishes as hλ → −∞); with the start included it is the
+(N, N−1) one, which grows without bound, so on a segment much longer than a damped mode's time constant the
+discrete problem admits growing modes that an optimizer exploits (the hang glider: design notes, 2026-12-03).
 
 This module computes the N LGR points (roots of P_{N−1} + P_N, by Newton's iteration from the
 Chebyshev–Gauss–Radau points) plus the non-collocated s = 1 as point 0, the barycentric weights, the Radau
-quadrature weights (0 at s = 1; exact to degree 2N − 2) and the collocation mask (`lgr_collocated`);
-pseudospectral.py uses the mask, so on K segments each joint column is collocated once, by the later segment
-in time. The weights are computed through (P_{N−1} − P_N)/2, which equals P_{N−1} at the roots but is less
-sensitive to their rounding (`_half_difference`).
+quadrature weights (0 at s = 1; exact to degree 2N − 2) and the collocation mask (`lgr_collocated`): LGR_START;
+LGR is its mirror image s → −s. pseudospectral.py uses the mask, so on K segments each joint column is
+collocated once, by the segment that ends there (LGR) or starts there (LGR_START). The weights are computed
+through (P_{N−1} − P_N)/2, which equals P_{N−1} at the roots but is less sensitive to their rounding
+(`_half_difference`).
 
 Equations and their derivation: docs/transcription.md, section "Pseudospectral" (family "Legendre–Gauss–Radau").
 """
@@ -17,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ocpkit.errors import OptionError
 from ocpkit.transcription.polynomials import NodeFamily, legendre
 from ocpkit.transcription.pseudospectral import Pseudospectral
 
@@ -60,14 +69,27 @@ def lgr_collocated(n: int) -> np.ndarray:
     return np.arange(n + 1) > 0
 
 
-LGR = NodeFamily("Legendre–Gauss–Radau", lgr_points, lgr_barycentric_weights, lgr_quadrature_weights, lgr_collocated)
+LGR_START = NodeFamily("Legendre–Gauss–Radau (start collocated)", lgr_points, lgr_barycentric_weights,
+                       lgr_quadrature_weights, lgr_collocated)
+LGR = NodeFamily("Legendre–Gauss–Radau", lambda n: -lgr_points(n)[::-1], lambda n: lgr_barycentric_weights(n)[::-1],
+                 lambda n: lgr_quadrature_weights(n)[::-1], lambda n: lgr_collocated(n)[::-1])
+"""The mirror image of LGR_START (barycentric weights are defined up to one factor, here (−1)^n)."""
+FAMILIES = {"end": LGR, "start": LGR_START}
 
 
 class LegendreGaussRadau(Pseudospectral):
-    """Legendre–Gauss–Radau (LGR) pseudospectral transcription, as in GPOPS-II and dymos.
-
-    N = `knots` intervals (N LGR points and the non-collocated end) on each of `segments` equal segments:
-    D X = h F at every point but t_f."""
+    """Legendre–Gauss–Radau (LGR) pseudospectral transcription: N = `knots` intervals (N LGR points and one that
+    is not collocated) on each of `segments` segments; `collocate` = "end" (default; L-stable) or "start" (as in
+    GPOPS-II and dymos) says which end of each segment is collocated. Other options: `Pseudospectral`."""
 
     name = "lgr"
     family = LGR
+
+    def __init__(self, *args, collocate: str = "end", **kwargs) -> None:
+        if collocate not in FAMILIES:
+            raise OptionError(f"lgr: collocate must be one of {sorted(FAMILIES)}, got {collocate!r}")
+        self.collocate, self.family = collocate, FAMILIES[collocate]
+        super().__init__(*args, **kwargs)
+
+    def options_key(self) -> tuple:
+        return *super().options_key(), self.collocate

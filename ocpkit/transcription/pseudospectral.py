@@ -167,7 +167,7 @@ class PseudospectralDiscretization(Discretization):
 
         # a Lobatto segment collocates its joints too: at a break its control may jump, so the earlier segment
         # gets a control of its own at the joint ("jump<b>"; LGR's joint is collocated by one segment only)
-        self.jumps = bool(grid.breaks) and bool(collocated[0])
+        self.jumps = bool(grid.breaks) and bool(collocated[0]) and bool(collocated[-1])
         runs, self.collocation_rows = [], []  # (column, first row of its state defect, quadrature weight)
         for b in range(K):
             own, at = x[b * N: b * N + N + 1], times[b * N: b * N + N + 1]

@@ -28,10 +28,11 @@ RNG = np.random.default_rng(3)
 TF = 2.0
 N = 6  # intervals per segment: every quintic is exact on every segment (one LGL segment needs N ≥ 6)
 # name → (transcription class, segments, collocated points per segment) of the NLPs under test: Lobatto families
-# impose D X = h F at all N + 1 points, Radau at all but t_f (so a joint column is collocated once, not twice)
+# impose D X = h F at all N + 1 points, Radau at all but one end (so a joint column is collocated once, not twice)
 SETUPS = {"lgl": (LegendreGaussLobatto, 1, N + 1), "lgl-2": (LegendreGaussLobatto, 2, N + 1),
           "chebyshev-3": (Chebyshev, 3, N + 1), "lgr": (LegendreGaussRadau, 1, N),
-          "lgr-3": (LegendreGaussRadau, 3, N)}
+          "lgr-3": (LegendreGaussRadau, 3, N), "lgr-start-3": (LegendreGaussRadau, 3, N)}
+OPTIONS = {"lgr-start-3": {"collocate": "start"}}
 PAPER = {"lgl": (8, 1), "chebyshev": (8, 2), "lgr": (16, 1)}  # transcription → (knots, segments) for the paper cases
 
 
@@ -101,7 +102,7 @@ def test_grid_knots_and_piecewise_interpolation(family):
 @functools.cache
 def build(setup: str):
     method, segments, _ = SETUPS[setup]
-    return discretize(PROBLEM, method.name, knots=N, segments=segments)
+    return discretize(PROBLEM, method.name, knots=N, segments=segments, **OPTIONS.get(setup, {}))
 
 
 @pytest.fixture(scope="module", params=list(SETUPS))
@@ -133,23 +134,25 @@ def test_equalities_vanish_exactly_on_motions_of_degree_n(setup, disc):
     assert np.abs(g[equalities]).max() > 1e-7  # one degree more and the defects show (small on short segments)
 
 
-def test_radau_leaves_the_slope_at_t_f_free():
-    """LGR imposes D X = h F at every point but t_f, LGL at every point: perturbing q̇ at t_f on the same motion
-    changes the same equality rows on both grids but for the two defects at t_f, which only LGL has."""
+@pytest.mark.parametrize("collocate, column", [("start", 0), ("end", -1)])
+def test_radau_leaves_the_slope_at_its_other_end_free(collocate, column):
+    """LGR imposes D X = h F at every point but one end (t_f when it collocates the start, the start when it
+    collocates the end), LGL at every point: perturbing q̇ there on the same motion changes the same equality rows
+    on both grids but for the two defects there, which only LGL has."""
     motion = polynomial_motion(PROBLEM, TF, Polynomial([0.0, 0.3, -0.2, 0.9, 0.4, -0.3]))
     changed = {}
-    for setup in ("lgl", "lgr"):
-        disc = build(setup)
+    for setup, options in (("lgl", {}), ("lgr", {"collocate": collocate})):
+        disc = discretize(PROBLEM, setup, knots=N, **options)
         w = disc.encode(motion)
         _, g0 = evaluate(disc, w, PROBLEM)
-        w[disc.nlp.variables.index("qd")[0, 2]] += 0.1  # column 0 is t = t_f
+        w[disc.nlp.variables.index("qd")[column, 2]] += 0.1  # column 0 is t = t_f, the last the start
         _, g1 = evaluate(disc, w, PROBLEM)
         equalities = disc.nlp.lbg == disc.nlp.ubg
         changed[setup] = np.abs(g1 - g0)[equalities] > 1e-6
         assert np.abs(g0[equalities]).max() < 1e-9
-    # q̇_0 enters the q-defect (D Q)_i − h q̇_i at i = 0 only, the q̇-defects (D Q̇)_i − h q̈_i at every
-    # collocated point (D_i0 ≠ 0), and knot 0's dynamics (the same on both grids: the same state at t_f). LGL has
-    # the q- and q̇-defects at t_f that LGR leaves out: exactly two rows more.
+    # q̇ there enters the q-defect (D Q)_i − h q̇_i at that point only, the q̇-defects (D Q̇)_i − h q̈_i at every
+    # collocated point, and that knot's dynamics (the same on both grids: the same state). LGL has the q- and
+    # q̇-defects there that LGR leaves out: exactly two rows more.
     assert changed["lgr"].sum() >= N  # the q̇-defects at the N collocated points
     assert changed["lgl"].sum() - changed["lgr"].sum() == 2
 

@@ -1,13 +1,18 @@
-"""LGR node family (flipped Radau: s = −1 collocated, s = +1 not) against numpy's Legendre series and scipy's
-Gauss–Jacobi rule."""
+"""LGR node families (LGR_START: s = −1 collocated, s = +1 not; LGR: its mirror image) against numpy's Legendre
+series, scipy's Gauss–Jacobi rule and the Padé approximants of e^z that are their stability functions."""
+
+import math
 
 import numpy as np
 import pytest
 from numpy.polynomial import Legendre
 from scipy.special import roots_jacobi
 
+from ocpkit.errors import OptionError
 from ocpkit.transcription.lgr import (
     LGR,
+    LGR_START,
+    LegendreGaussRadau,
     lgr_barycentric_weights,
     lgr_collocated,
     lgr_points,
@@ -71,8 +76,9 @@ def test_barycentric_weights_match_the_product_formula(n):
 
 
 @pytest.mark.parametrize("n", NS)
-def test_differentiation_is_exact_to_degree_n_at_all_points(n):
-    s, D = lgr_points(n), LGR.differentiation(n)
+@pytest.mark.parametrize("family", [LGR, LGR_START], ids=["end", "start"])
+def test_differentiation_is_exact_to_degree_n_at_all_points(n, family):
+    s, D = family.points(n), family.differentiation(n)
     for degree in sorted({0, 1, n // 2, n}):
         p = Legendre(RNG.normal(size=degree + 1))
         exact = p.deriv()(s)
@@ -80,16 +86,55 @@ def test_differentiation_is_exact_to_degree_n_at_all_points(n):
 
 
 @pytest.mark.parametrize("n", NS)
-def test_interpolation_reproduces_degree_n_polynomials(n):
-    s, t = lgr_points(n), RNG.uniform(-1, 1, size=50)
+@pytest.mark.parametrize("family", [LGR, LGR_START], ids=["end", "start"])
+def test_interpolation_reproduces_degree_n_polynomials(n, family):
+    s, t = family.points(n), RNG.uniform(-1, 1, size=50)
     p = Legendre(RNG.normal(size=n + 1))
-    np.testing.assert_allclose(LGR.interpolation(n, t) @ p(s), p(t), rtol=0, atol=1e-12)
-    np.testing.assert_allclose(LGR.interpolation(n, s), np.eye(n + 1), atol=0)
+    np.testing.assert_allclose(family.interpolation(n, t) @ p(s), p(t), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(family.interpolation(n, s), np.eye(n + 1), atol=0)
 
 
 @pytest.mark.parametrize("n", NS)
 def test_only_point_0_is_not_collocated(n):
     assert lgr_collocated(n).tolist() == [False] + [True] * n
+
+
+@pytest.mark.parametrize("n", NS)
+def test_the_default_family_is_the_mirror_image(n):
+    np.testing.assert_array_equal(LGR.points(n), -lgr_points(n)[::-1])
+    np.testing.assert_array_equal(LGR.quadrature_weights(n), lgr_quadrature_weights(n)[::-1])
+    assert LGR.collocation_mask(n).tolist() == [True] * n + [False]  # the start (s = −1, the last point) is not
+
+
+def pade(p: int, q: int, z: float) -> float:
+    """The (p, q) Padé approximant of e^z (numerator degree p, denominator q), closed form."""
+    def series(m: int, sign: int) -> float:
+        return sum(math.factorial(p + q - j) * math.factorial(m) / (math.factorial(p + q) * math.factorial(j)
+                   * math.factorial(m - j)) * (sign * z) ** j for j in range(m + 1))
+    return series(p, 1) / series(q, -1)
+
+
+def step(family, n: int, z: float) -> float:
+    """x at the segment's end after collocating x' = λ x from x = 1 at its start, z = λ × (segment duration)."""
+    D, mask = family.differentiation(n), family.collocation_mask(n)
+    rows = (D - (z / 2) * np.eye(n + 1))[mask]  # D X = h λ X at the collocated points, h = duration / 2
+    free = rows[:, :-1]  # the last point (s = −1, the start) has x = 1
+    return float(np.linalg.solve(free, -rows[:, -1])[0])
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 9])
+def test_stability_functions_are_the_pade_approximants(n):
+    """Collocating the end gives the (n − 1, n) Padé approximant of e^z (Radau IIA), collocating the start the
+    (n, n − 1) one: both exact to order 2n − 1, but only the first decays where hλ → −∞."""
+    for z in (-0.3, 0.7, -5.0, -50.0):
+        assert step(LGR, n, z) == pytest.approx(pade(n - 1, n, z), rel=1e-9, abs=1e-12)
+        assert step(LGR_START, n, z) == pytest.approx(pade(n, n - 1, z), rel=1e-9)
+    assert abs(step(LGR, n, -1e4)) < 1e-3 < 1.0 < abs(step(LGR_START, n, -1e4))
+
+
+def test_rejects_an_unknown_end():
+    with pytest.raises(OptionError, match="collocate"):
+        LegendreGaussRadau(collocate="middle")
 
 
 def test_rejects_fewer_than_one_interval():
