@@ -54,8 +54,10 @@ FAMILIES = {"Chebyshev–Gauss–Lobatto": CHEBYSHEV, "Legendre–Gauss–Lobatt
 # - **Chebyshev–Gauss–Lobatto** (CGL): s_i = cos(iπ/N), the projections of equally spaced points on a
 #   half circle. Both ends are nodes.
 # - **Legendre–Gauss–Lobatto** (LGL): ±1 and the roots of P′_N (P_N the Legendre polynomial).
-# - **Legendre–Gauss–Radau** (LGR): −1 and the roots of (P_{N−1} + P_N)/(1 + s); ocpkit adds s = +1 as a
-#   node where the dynamics are *not* collocated (open marker below), as GPOPS-II and dymos do.
+# - **Legendre–Gauss–Radau** (LGR): +1 and the roots of (P_{N−1} − P_N)/(1 − s); ocpkit adds s = −1 as a
+#   node where the dynamics are *not* collocated (open marker below). GPOPS-II and dymos use the mirror image
+#   (collocate −1, add +1; `collocate="start"`), whose discrete dynamics can grow where the true ones decay
+#   fast (docs, "Transcription equations").
 
 # %%
 n = 8

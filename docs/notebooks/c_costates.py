@@ -121,9 +121,9 @@ fig.savefig(FIGURES / "c-costates.png", dpi=120)
 # arc is one smooth piece on its own segment, and both costates follow the analytic ones closely (the
 # printed errors above).
 #
-# At a segment boundary the LGR estimate belongs to the segment that *starts* there (LGR collocates the start
-# of each segment, not its end), so the node at t = 1/3 shows the middle arc's λₓ = 0, and the node at
-# t = 2/3 the last arc's −18.
+# At a segment boundary the LGR estimate belongs to the segment that *ends* there (ocpkit's LGR collocates the
+# end of each segment, not its start), so the node at t = 1/3 shows the first arc's λₓ = 18, and the node at
+# t = 2/3 the middle arc's 0.
 #
 # Here the junctions were known in advance. In general they are not, which is why practical
 # pseudospectral solvers (GPOPS-II, for example) move or add segment boundaries adaptively, guided by
