@@ -35,6 +35,12 @@ plan returns at once; the budget is what a failure costs. A ladder that verifies
 found no path, ends `no_path`, with the configurations the last search checked: where the obstacles leave no way
 through, that is the evidence, and no failed solve says more.
 
+The safety net (`Rung.safety_net`, after the first OMPL rung): where that rung found a path but its solve did not
+verify, ompl-topp3 times the same path (reused, not searched again: ocpkit.planner.ompl_seed) along its fixed
+geometry under every limit, a motion that usually verifies, slower than an optimal one. Its verified plan does not
+stop the ladder, which climbs on for a plan that is optimal in path and timing together; it is the answer only when
+no other rung verifies (anytime: the best certified plan found within the budget, its rung named).
+
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
 options on a finer grid (`finer_grid`: one more pseudospectral segment; half as many intervals again for a local
@@ -73,7 +79,8 @@ class Rung:
     `relaxed`: a continuation, solving the problem relaxed (ocpkit.planner.refinement.RELAXED) first to warm-start
     the real one, and `refines`: a motion to re-solve on a finer grid than the rung's own (`finer`), its guess
     instead of `guess`. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the
-    ladder's time is up."""
+    ladder's time is up. A `safety_net` rung (guess "ompl") plans with ompl-topp3 instead, on the OMPL path of
+    its `seed` (module docstring); the simultaneous planner runs it, not `apply`."""
 
     name: str
     guess: str | None = None
@@ -83,6 +90,7 @@ class Rung:
     max_iterations: int | None = None
     relaxed: bool = False
     refines: Trajectory | None = field(default=None, compare=False, repr=False)
+    safety_net: bool = False
 
     def apply(self, options: SimultaneousOptions, left: float) -> SimultaneousOptions:
         """`options` with this rung's overrides. A rung's guess comes with its own options instead of the call's:
@@ -129,6 +137,7 @@ def finer_grid(options: SimultaneousOptions) -> SimultaneousOptions:
 DEFAULT_LADDER: tuple[Rung, ...] = (
     Rung("first", max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("ompl-0-segments-3", guess="ompl", seed=0, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-0-topp3", guess="ompl", seed=0, safety_net=True),
     Rung("ompl-1-segments-3", guess="ompl", seed=1, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("relaxed-first", relaxed=True, max_iterations=MAX_ITERATIONS_CAPPED),
@@ -150,13 +159,16 @@ STATUS_ORDER = ("verified", "violated", "infeasible", "iteration_limit", "time_l
 def ordered(ladder: Sequence[Rung], line_buried: bool) -> tuple[Rung, ...]:
     """`ladder` as it is, or, when the straight line has a sphere centre inside an obstacle box or cylinder somewhere
     (`line_buried`), with the rungs before the first OMPL rung that start from the call's guess (`guess` None, not
-    relaxed) moved after that rung (module docstring)."""
+    relaxed) moved after that rung and the safety nets that follow it (module docstring)."""
     first = next((k for k, rung in enumerate(ladder) if rung.guess == "ompl"), None)
     if not line_buried or first is None:
         return tuple(ladder)
+    end = first + 1  # the OMPL rung with the safety nets right after it
+    while end < len(ladder) and ladder[end].safety_net:
+        end += 1
     moved = [rung for rung in ladder[:first] if rung.guess is None and not rung.relaxed]
     kept = [rung for rung in ladder[:first] if rung not in moved]
-    return (*kept, ladder[first], *moved, *ladder[first + 1:])
+    return (*kept, *ladder[first:end], *moved, *ladder[end:])
 
 
 def rank(plan: Plan) -> tuple[int, float]:
@@ -168,9 +180,10 @@ def rank(plan: Plan) -> tuple[int, float]:
 
 def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:
     """Plan with `attempt(rung, seconds left)` on each rung of `ladder` in turn, each followed by its `finer` rung
-    when its plan calls for one (on None once if the ladder is empty), until one verifies or the `max_wall_time` (s)
-    of computation and set-up is spent (no rung starts with less time left than the last rung's set-up took); the
-    first verified plan, else the best by `rank`, with the stats of all attempts (module docstring)."""
+    when its plan calls for one (on None once if the ladder is empty), until one that is not a safety net verifies
+    or the `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than the last
+    rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module docstring). A
+    safety net runs only where an OMPL rung of its seed found a path."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
@@ -185,13 +198,13 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     for rung in ladder:
         if not room():
             break
-        if _repeats(rung, tried):
+        if _repeats(rung, tried) or (rung.safety_net and not _path_found(rung.seed, tried)):
             skipped.append(rung.name)
             continue
         tried.append((rung, attempt(rung, max(left(), 0.0))))
         if (next_rung := finer(*tried[-1])) is not None and room():
             tried.append((next_rung, attempt(next_rung, left())))
-        if tried[-1][1].ok:
+        if tried[-1][1].ok and not tried[-1][0].safety_net:
             break
     return _combined(tried, skipped)
 
@@ -199,7 +212,7 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
 def finer(rung: Rung, plan: Plan) -> Rung | None:
     """The rung re-solving `plan`'s motion on a finer grid (module docstring) when `plan`, planned on `rung`,
     is violated only where refinement rounds cannot help; None otherwise, and for a rung that was itself one."""
-    if plan.status != "violated" or plan.verification.fixable or rung.refines is not None:
+    if plan.status != "violated" or plan.verification.fixable or rung.refines is not None or rung.safety_net:
         return None
     cap = min(rung.max_iterations or FINER_ITERATIONS, FINER_ITERATIONS)
     return dataclasses.replace(rung, name=f"{rung.name}-finer", guess=None, seed=None, max_iterations=cap,
@@ -215,14 +228,19 @@ def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:
     return any(solve(r) == solve(rung) and p.status != "iteration_limit" for r, p in tried)
 
 
+def _path_found(seed: int | None, tried: list[tuple[Rung, Plan]]) -> bool:
+    """Whether an OMPL rung of `seed` in `tried` found a path (its plan is not `no_path`)."""
+    return any(r.guess == "ompl" and r.seed == seed and not r.safety_net and p.status != "no_path" for r, p in tried)
+
+
 def _combined(tried: list[tuple[Rung, Plan]], skipped: list[str]) -> Plan:
-    """The best plan of `tried` (rung, plan) pairs, its times and iterations summed over all of them, the rungs
-    tried and the names of the `skipped` ones in its stats, and its method and message naming its rung. When none
-    verified and every OMPL rung's search found no path, the last one's `no_path` plan instead (its message: the
-    checks the search spent), with the hint NO_PATH_HINT."""
-    rung, best = min(tried, key=lambda pair: rank(pair[1]))
+    """The best plan of `tried` (rung, plan) pairs (by `rank`, a safety net's last among equals), its times and
+    iterations summed over all of them, the rungs tried and the names of the `skipped` ones in its stats, and its
+    method and message naming its rung. When none verified and every OMPL rung's search found no path, the last
+    one's `no_path` plan instead (its message: the checks the search spent), with the hint NO_PATH_HINT."""
+    rung, best = min(tried, key=lambda pair: (rank(pair[1]), pair[0].safety_net))
     plans = [p for _, p in tried]
-    searched = [(r, p) for r, p in tried if r.guess == "ompl"]
+    searched = [(r, p) for r, p in tried if r.guess == "ompl" and not r.safety_net]
     no_path = not best.ok and bool(searched) and all(p.status == "no_path" for _, p in searched)
     if no_path:  # the failed searches are the evidence a failed solve is not
         rung, best = searched[-1]

@@ -12,7 +12,9 @@ step is one function below, `ompl_seed` runs them in turn:
    configurations at most `resolution` rad apart (Euclidean over the joints). An RRT extends at most `max_step`
    rad at a time (MAX_STEP; OMPL's own default, a fifth of the joint box's diagonal, is several radians on a
    6- or 7-joint arm, and such long extensions into a cage or a shelf mostly fail). OMPL's PathSimplifier then
-   shortens the path until it stops improving.
+   shortens the path until it stops improving. The last FOUND_PATHS paths found are kept: a search of the same
+   problem object with the same options returns its path again without searching (the simultaneous planner's
+   ladder times the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
 3. `smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
    tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
    obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
@@ -48,6 +50,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections import OrderedDict
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -70,6 +73,7 @@ FRICTION_PASSES = 2
 TORQUE_RATE_WINDOW = 1e-3  # s
 MAX_STEP = 1.0  # rad: an RRT's longest extension (OMPL's `range`; module docstring)
 SEGMENT_BATCH = 16  # configurations counted for a segment's first batch; later batches double (`segment_free`)
+FOUND_PATHS = 4  # paths kept for a repeated search (`ompl_path`)
 
 
 class FreeSpace:
@@ -209,24 +213,49 @@ class OmplPath:
     simplify_time: float
 
 
+_found: OrderedDict[tuple, tuple[Problem, np.ndarray, int, float]] = OrderedDict()
+"""The last FOUND_PATHS paths found: (problem, waypoints, configurations checked, seconds) by (id(problem), the
+search's options but its budgets); the problem is held so that its id is not reused while the entry lives."""
+
+
 def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
                resolution: float, max_checks: int | None = None, max_step: float | None = MAX_STEP) -> OmplPath:
     """Plan start → goal with the named OMPL planner (RRTs extending at most `max_step` rad) until it stops with an
     exact path, `planning_time` seconds have passed or (if given) `free` has checked more than `max_checks`
     configurations, then simplify the path to convergence. A budget in checks repeats on any machine; one in seconds
-    does not.
+    does not. The same `problem` object searched again with the same options, and budgets that the search before
+    stayed within, gets the path found then without searching (no time; `free` counts the checks it took), if it
+    is among the last FOUND_PATHS found.
 
     The time budget is OMPL's own timer. A check budget is a Python condition, safe only for planners that plan in
     the calling thread (RRTConnect, RRT*, BIT*): PRM checks for a solution in a second thread, which would deadlock
     waiting for the interpreter lock that the planning thread holds."""
-    import ompl.base as ob
-    import ompl.geometric as og
-    import ompl.util as ou
-
     if max_step is not None and not (np.isfinite(max_step) and max_step > 0):
         raise OptionError(f"max_step must be a finite number of radians > 0, got {max_step}")
     if max_checks is not None and planner_name == "prm":
         raise OptionError("max_checks cannot stop prm (it plans in a second thread); give it a planning_time")
+    key = (id(problem), free.margin, planner_name, seed, resolution, max_step)
+    if key in _found and _found[key][0] is problem:
+        _, waypoints, checks, seconds = _found[key]
+        if (max_checks is None or checks <= max_checks) and seconds <= planning_time:
+            free.checks += checks
+            return OmplPath(waypoints, 0.0, 0.0)
+    before = free.checks
+    found = _search(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
+    if found.waypoints is not None:
+        _found[key] = problem, found.waypoints, free.checks - before, found.path_time
+        while len(_found) > FOUND_PATHS:
+            _found.popitem(last=False)
+    return found
+
+
+def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
+            resolution: float, max_checks: int | None, max_step: float | None) -> OmplPath:
+    """`ompl_path`'s search and simplification."""
+    import ompl.base as ob
+    import ompl.geometric as og
+    import ompl.util as ou
+
     with _ompl_log_level(ou, ou.LOG_ERROR):
         _seed_ompl(ou, seed)
         si = _space_information(problem, free, resolution)

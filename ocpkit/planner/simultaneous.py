@@ -20,10 +20,10 @@ from ocpkit.errors import NoGuess, OptionError
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.geometry.clearances import buried, sphere_centers_batch
 from ocpkit.nlp import Refinement
-from ocpkit.planner import GUESSES, screening
+from ocpkit.planner import GUESSES, PLANNERS, screening
 from ocpkit.planner.build_cache import Build, build
 from ocpkit.planner.guesses import STRAIGHT_LINE_RULES
-from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, Rung, climb, ordered
+from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, OMPL_RESOLUTION, Rung, climb, ordered
 from ocpkit.planner.ompl_seed import hold
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
@@ -70,6 +70,8 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
         guess_options=guess_options or {}, fallbacks=fallbacks, screen=screen)
 
     def attempt(rung: Rung | None, left: float) -> Plan:
+        if rung is not None and rung.safety_net:
+            return _timed_path(problem, options, rung.seed or 0, left)
         return _single_shot(problem, options if rung is None else rung.apply(options, left), left)
 
     return climb(attempt, ordered(options.fallbacks, _buried_line(problem, options)), options.max_wall_time)
@@ -134,6 +136,18 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     return finish(problem, refined.trajectory, stopped, method, started, setup_time=first_setup,
                   iterations=refined.iterations, rounds=refined.rounds, message=result.message,
                   verification=refined.verification, timing=timing, screening=screened)
+
+
+def _timed_path(problem: Problem, options: SimultaneousOptions, seed: int, max_wall_time: float) -> Plan:
+    """The ompl-topp3 planner's plan (registry PLANNERS) on the path an OMPL rung of `seed` searched for (the same
+    search options, so the path found is reused: ocpkit.planner.ompl_seed.ompl_path), its timing solved with the
+    call's transcription, grid, dynamics and solver within `max_wall_time` (s)."""
+    return PLANNERS.get("ompl-topp3")(
+        problem, transcription=options.transcription, knots=options.knots, dynamics=options.dynamics,
+        solver=options.solver, refinements=options.refinements, transcription_options=options.transcription_options,
+        solver_options=options.solver_options, dynamics_options=options.dynamics_options,
+        max_wall_time=max_wall_time, planning_time=max_wall_time, seed=seed, resolution=OMPL_RESOLUTION,
+        max_checks=OMPL_CHECKS)
 
 
 def _screening_start(problem: Problem, options: SimultaneousOptions) -> np.ndarray | None:

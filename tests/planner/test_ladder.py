@@ -84,6 +84,34 @@ def test_a_failure_reports_the_best_rungs_status(statuses, best):
     assert climb(script, LADDER, 60.0).status == best
 
 
+NETTED = (Rung("a"), Rung("b", guess="ompl", seed=1), Rung("net", guess="ompl", seed=1, safety_net=True),
+          Rung("c", knots=16))
+
+
+def test_a_verified_safety_net_does_not_stop_the_ladder_and_a_later_verified_rung_wins():
+    script = Script({"a": fake("infeasible"), "b": fake("violated", 0.01), "net": fake("verified"),
+                     "c": fake("verified")})
+    result = climb(script, NETTED, 60.0)
+    assert [name for name, _ in script.calls] == ["a", "b", "net", "c"]
+    assert result.method["rung"] == "c"
+
+
+def test_the_safety_nets_plan_is_the_answer_when_no_other_rung_verifies():
+    script = Script({"a": fake("infeasible"), "b": fake("iteration_limit"), "net": fake("verified", seconds=2.0),
+                     "c": fake("violated", 0.001)})
+    result = climb(script, NETTED, 60.0)
+    assert result.ok and result.method["rung"] == "net"
+    assert result.stats.solve_time == 5.0 and [r.rung for r in result.stats.rungs] == ["a", "b", "net", "c"]
+
+
+def test_the_safety_net_is_skipped_where_its_seeds_search_found_no_path():
+    script = Script({"a": fake("infeasible"), "b": fake("no_path"), "net": fake("verified"),
+                     "c": fake("infeasible")})
+    result = climb(script, NETTED, 60.0)
+    assert [name for name, _ in script.calls] == ["a", "b", "c"] and result.stats.skipped == ("net",)
+    assert result.status == "no_path"  # the search's evidence, as without the net
+
+
 def test_rank_orders_by_status_then_violation():
     plans = [fake("time_limit"), fake("violated", 0.3), fake("verified"), fake("infeasible"), fake("violated", 0.1)]
     assert [(p.status, p.verification.checks[0].worst) for p in sorted(plans, key=rank)] == [
@@ -138,18 +166,18 @@ def test_a_rung_overrides_only_what_it_names():
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
-    (DEFAULT_LADDER[2], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
+    (DEFAULT_LADDER[3], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
                          "guess_options": {"fallback": False, "seed": 1, "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
-    (DEFAULT_LADDER[3], {"guess": "ompl", "knots": 16,
+    (DEFAULT_LADDER[4], {"guess": "ompl", "knots": 16,
                          "guess_options": {"fallback": False, "seed": 2, "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
-    (DEFAULT_LADDER[4], {"relaxed": True, "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
-    (DEFAULT_LADDER[5], {})])
+    (DEFAULT_LADDER[5], {"relaxed": True, "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+    (DEFAULT_LADDER[6], {})])
 def test_each_default_rung_changes_the_calls_options_as_it_says(rung, changes):
     call = SimultaneousOptions(guess_options={"seed": 9})
     assert rung.apply(call, 7.0) == dataclasses.replace(call, **changes)
@@ -189,7 +217,9 @@ def test_a_buried_line_moves_the_rungs_that_start_from_it_after_the_first_ompl_r
     assert ordered(ladder, False) == ladder
     assert [r.name for r in ordered(ladder, True)] == ["relaxed", "b", "a", "c"]
     assert ordered(ladder[:2], True) == ladder[:2]  # no OMPL rung: nothing to move
-    assert [r.name for r in ordered(DEFAULT_LADDER, True)][:2] == [DEFAULT_LADDER[1].name, DEFAULT_LADDER[0].name]
+    assert [r.name for r in ordered(DEFAULT_LADDER, True)][:3] == [
+        DEFAULT_LADDER[1].name, DEFAULT_LADDER[2].name, DEFAULT_LADDER[0].name]  # the OMPL rung keeps its net
+    assert [r.name for r in ordered(NETTED, True)] == ["b", "net", "a", "c"]
 
 
 def test_a_straight_line_with_a_sphere_centre_inside_an_obstacle_plans_the_ompl_rung_first(monkeypatch):

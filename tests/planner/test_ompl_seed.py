@@ -123,3 +123,27 @@ def test_a_slowed_motion_is_the_same_path_at_a_slower_pace_with_its_own_torque(c
 def test_a_hold_is_not_slowed(case1):
     still = ompl_seed(dataclasses.replace(case1, goal=case1.start.copy()))
     assert still.stopped is None and still.path is None and slowed(still.trajectory, 2.0) is still.trajectory
+
+
+def test_a_repeated_search_reuses_the_path_found_with_its_checks(case1):
+    free = ompl_seed_module.planning_space(case1, 0.01)
+    first = ompl_seed_module.ompl_path(case1, free, "rrtconnect", 5.0, 4, 0.02, max_checks=10**6)
+    again_free = ompl_seed_module.planning_space(case1, 0.01)
+    again = ompl_seed_module.ompl_path(case1, again_free, "rrtconnect", 5.0, 4, 0.02, max_checks=10**6)
+    assert first.waypoints is not None and again.waypoints is first.waypoints
+    assert again.path_time == 0.0 and again_free.checks == free.checks > 0
+    other = dataclasses.replace(case1)  # an equal problem, another object: searched again
+    fresh = ompl_seed_module.ompl_path(other, ompl_seed_module.planning_space(other, 0.01), "rrtconnect", 5.0, 4,
+                                       0.02, max_checks=10**6)
+    assert fresh.path_time > 0.0
+    np.testing.assert_array_equal(fresh.waypoints, first.waypoints)  # the same seed finds the same path
+
+
+def test_a_search_with_a_smaller_budget_than_the_path_took_searches_again(case1):
+    free = ompl_seed_module.planning_space(case1, 0.01)
+    found = ompl_seed_module.ompl_path(case1, free, "rrtconnect", 5.0, 5, 0.02, max_checks=10**6)
+    assert found.waypoints is not None and free.checks > 1
+    short = ompl_seed_module.ompl_path(case1, ompl_seed_module.planning_space(case1, 0.01), "rrtconnect", 5.0, 5,
+                                       0.02, max_checks=1)
+    assert short.path_time > 0.0  # searched, not reused
+    assert ompl_seed_module.ompl_path(case1, free, "rrtconnect", 0.0, 5, 0.02).waypoints is None
