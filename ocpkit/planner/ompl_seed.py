@@ -13,8 +13,8 @@ step is one function below, `ompl_seed` runs them in turn:
    rad at a time (MAX_STEP; OMPL's own default, a fifth of the joint box's diagonal, is several radians on a
    6- or 7-joint arm, and such long extensions into a cage or a shelf mostly fail). OMPL's PathSimplifier then
    shortens the path until it stops improving. The last FOUND_PATHS paths found are kept: a search of the same
-   problem object with the same options returns its path again without searching (the simultaneous planner's
-   ladder times the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
+   problem object with the same options, budgeted in checks, returns its path again without searching (the
+   simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
 3. `smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
    tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
    obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
@@ -213,9 +213,9 @@ class OmplPath:
     simplify_time: float
 
 
-_found: OrderedDict[tuple, tuple[Problem, np.ndarray, int, float]] = OrderedDict()
-"""The last FOUND_PATHS paths found: (problem, waypoints, configurations checked, seconds) by (id(problem), the
-search's options but its budgets); the problem is held so that its id is not reused while the entry lives."""
+_found: OrderedDict[tuple, tuple[Problem, np.ndarray, int]] = OrderedDict()
+"""The last FOUND_PATHS paths found: (problem, waypoints, configurations checked) by (id(problem), the search's
+options but its budgets); the problem is held so that its id is not reused while the entry lives."""
 
 
 def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
@@ -223,9 +223,9 @@ def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_tim
     """Plan start → goal with the named OMPL planner (RRTs extending at most `max_step` rad) until it stops with an
     exact path, `planning_time` seconds have passed or (if given) `free` has checked more than `max_checks`
     configurations, then simplify the path to convergence. A budget in checks repeats on any machine; one in seconds
-    does not. The same `problem` object searched again with the same options, and budgets that the search before
-    stayed within, gets the path found then without searching (no time; `free` counts the checks it took), if it
-    is among the last FOUND_PATHS found.
+    does not. So a search budgeted in checks that stays within a search before it (the same `problem` object and
+    options, a `max_checks` at least the checks that search took) gets the path found then, without searching
+    again (no time; `free` counts the checks it took), if it is among the last FOUND_PATHS found.
 
     The time budget is OMPL's own timer. A check budget is a Python condition, safe only for planners that plan in
     the calling thread (RRTConnect, RRT*, BIT*): PRM checks for a solution in a second thread, which would deadlock
@@ -236,14 +236,14 @@ def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_tim
         raise OptionError("max_checks cannot stop prm (it plans in a second thread); give it a planning_time")
     key = (id(problem), free.margin, planner_name, seed, resolution, max_step)
     if key in _found and _found[key][0] is problem:
-        _, waypoints, checks, seconds = _found[key]
-        if (max_checks is None or checks <= max_checks) and seconds <= planning_time:
+        _, waypoints, checks = _found[key]
+        if max_checks is not None and checks <= max_checks:
             free.checks += checks
             return OmplPath(waypoints, 0.0, 0.0)
     before = free.checks
     found = _search(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
     if found.waypoints is not None:
-        _found[key] = problem, found.waypoints, free.checks - before, found.path_time
+        _found[key] = problem, found.waypoints, free.checks - before
         while len(_found) > FOUND_PATHS:
             _found.popitem(last=False)
     return found

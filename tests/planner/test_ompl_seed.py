@@ -139,7 +139,7 @@ def test_a_repeated_search_reuses_the_path_found_with_its_checks(case1):
     np.testing.assert_array_equal(fresh.waypoints, first.waypoints)  # the same seed finds the same path
 
 
-def test_a_search_with_a_smaller_budget_than_the_path_took_searches_again(case1):
+def test_a_search_budgeted_in_time_or_in_fewer_checks_than_the_path_took_searches_again(case1):
     free = ompl_seed_module.planning_space(case1, 0.01)
     found = ompl_seed_module.ompl_path(case1, free, "rrtconnect", 5.0, 5, 0.02, max_checks=10**6)
     assert found.waypoints is not None and free.checks > 1
