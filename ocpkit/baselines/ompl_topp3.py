@@ -116,7 +116,9 @@ def time_path(problem: Problem, smooth: PathSpline, transcription: str = "chebys
               dynamics_options: dict | None = None, max_wall_time: float = 60.0, grid_points: int = 1000
               ) -> TimedPath:
     """The optimal timing of the fixed path `smooth` (from problem.start to problem.goal) under `problem`'s limits
-    and cost (the module docstring's step 3; options as for `plan_ompl_topp3`)."""
+    and cost (the module docstring's step 3; options as for `plan_ompl_topp3`), within `max_wall_time` (s) from
+    the call: the TOPP-RA warm start, the build and the solves."""
+    deadline = time.perf_counter() + max_wall_time
     path = smooth.split(-(-smooth.intervals // PIECES_STEP) * PIECES_STEP)
     timed = time_optimal(problem, ToppraPath(path), grid_points)
     ocp = PathTimingOCP(problem.robot, path)
@@ -129,8 +131,7 @@ def time_path(problem: Problem, smooth: PathSpline, transcription: str = "chebys
     else:
         w, start, toppra_tf = discretization.encode(toppra_profile(timed[0])), "from TOPP-RA's profile", \
             float(timed[1][-1])
-    refined = solve_refined(discretization, made.solver, problem, w, refinements,
-                            time.perf_counter() + max_wall_time)
+    refined = solve_refined(discretization, made.solver, problem, w, refinements, deadline)
     return TimedPath(refined, made.setup_time, start, toppra_tf)
 
 
@@ -144,7 +145,8 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     """Plan `problem` by OMPL path, quintic smoothing and optimal timing along the path (module docstring).
 
     The timing OCP's options are `plan_simultaneous`'s (`transcription`, `knots`, `dynamics`, `solver`,
-    `refinements`, their option dicts; `max_wall_time` (s) bounds its solves); the path's are `plan_ompl_toppra`'s
+    `refinements`, their option dicts; `max_wall_time` (s) bounds the whole plan from the call, set-up
+    included, the search by `planning_time` too); the path's are `plan_ompl_toppra`'s
     (`planner_name`, `planning_time`, `seed`, `resolution`, `margin`, `max_checks`, `max_step`; `grid_points` for the
     TOPP-RA warm start).
 
@@ -170,7 +172,7 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
     smooth, rounds = smooth_path(found.waypoints, free, resolution, fit=PathSpline.fit, within_limits=True)
     smoothed = time.perf_counter()
     timing = time_path(problem, smooth, transcription, knots, dynamics, solver, refinements, transcription_options,
-                       solver_options, dynamics_options, max_wall_time, grid_points)
+                       solver_options, dynamics_options, max_wall_time - (time.perf_counter() - began), grid_points)
     refined, result = timing.refined, timing.refined.result
     spent = dataclasses.replace(searched, smooth=smoothed - smoothing, rounds=refined.timing)
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
