@@ -39,10 +39,7 @@ The safety net (`Rung.safety_net`, after the first OMPL rung): where that rung f
 verify, ompl-topp3 times the same path (reused, not searched again: ocpkit.planner.ompl_seed) along its fixed
 geometry under every limit, a motion that usually verifies, slower than an optimal one. Its verified plan does not
 stop the ladder, which climbs on for a plan that is optimal in path and timing together; it is the answer only when
-no other rung verifies (anytime: the best certified plan found within the budget, its rung named). The rung before
-a net leaves it NET_SECONDS of the budget (on MBM's Panda and UR5 training problems the net computed 1.1–2.4 s,
-and its build counts against what is left too), so that a solve that runs out the budget does not take the net's
-time too.
+no other rung verifies (anytime: the best certified plan found within the budget, its rung named).
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
@@ -71,7 +68,6 @@ MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the si
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
-NET_SECONDS = 4.0  # s a rung leaves of the budget for the safety net that follows it
 
 
 @dataclass(frozen=True)
@@ -187,8 +183,7 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     when its plan calls for one (on None once if the ladder is empty), until one that is not a safety net verifies
     or the `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than the last
     rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module docstring). A
-    safety net runs only where an OMPL rung of its seed found a path; the rung before it (and its finer rung) gets
-    NET_SECONDS less."""
+    safety net runs only where an OMPL rung of its seed found a path."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
@@ -200,16 +195,15 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     def room() -> bool:  # time for at least a build as long as the last one: a rung that cannot build only overruns
         return not tried or left() > tried[-1][1].stats.setup_time
 
-    for k, rung in enumerate(ladder):
+    for rung in ladder:
         if not room():
             break
         if _repeats(rung, tried) or (rung.safety_net and not _path_found(rung.seed, tried)):
             skipped.append(rung.name)
             continue
-        reserve = NET_SECONDS if k + 1 < len(ladder) and ladder[k + 1].safety_net else 0.0
-        tried.append((rung, attempt(rung, max(left() - reserve, 0.0))))
+        tried.append((rung, attempt(rung, max(left(), 0.0))))
         if (next_rung := finer(*tried[-1])) is not None and room():
-            tried.append((next_rung, attempt(next_rung, max(left() - reserve, 0.0))))
+            tried.append((next_rung, attempt(next_rung, left())))
         if tried[-1][1].ok and not tried[-1][0].safety_net:
             break
     return _combined(tried, skipped)

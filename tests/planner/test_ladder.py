@@ -21,8 +21,8 @@ from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
-from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NET_SECONDS, NO_PATH_HINT, OMPL_CHECKS,
-                                   OMPL_RESOLUTION, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
+from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_RESOLUTION,
+                                   SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow
@@ -102,13 +102,6 @@ def test_the_safety_nets_plan_is_the_answer_when_no_other_rung_verifies():
     result = climb(script, NETTED, 60.0)
     assert result.ok and result.method["rung"] == "net"
     assert result.stats.solve_time == 5.0 and [r.rung for r in result.stats.rungs] == ["a", "b", "net", "c"]
-
-
-def test_the_rung_before_a_safety_net_leaves_it_its_seconds():
-    script = Script({"a": fake("infeasible", seconds=1.5), "b": fake("iteration_limit", seconds=4.0),
-                     "net": fake("verified"), "c": fake("verified")})
-    climb(script, NETTED, 12.0)
-    assert script.calls[:3] == [("a", 12.0), ("b", 10.0 - NET_SECONDS), ("net", 5.5)]  # each spent 0.5 s set-up
 
 
 def test_the_safety_net_is_skipped_where_its_seeds_search_found_no_path():
