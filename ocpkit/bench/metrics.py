@@ -4,10 +4,12 @@ Per plan, from the dense samples: joint-space path length (rad, Σ‖Δq‖₂),
 tool frame: `end_effector_frame`), peak torque and torque-rate use (max over time and joints of |τ|/τ_max and
 |τ̇|/τ̇_max; 1 is the limit). Per group (a method, or a method on a scene): runs, success (= verified) rate, and
 over the verified runs the computation time's mean, median, 75th and 98th percentile, motion time t_f, the path
-lengths and the peak uses (medians).
+lengths and the peak uses (medians); and where the time goes (`time_split`, from each row's `extra` timing).
 """
 
 from __future__ import annotations
+
+import json
 
 import numpy as np
 import pinocchio as pin
@@ -63,15 +65,64 @@ verified runs; `all_*`: computation plus set-up over every run, failures include
 medians over the verified runs."""
 
 
+SPLIT_COLUMNS = ("runs", "setup_s", "guess_s", "solves_s", "verify_s", "rest_s", "iterations", "ms_per_iteration",
+                 "rounds", "rebuilds")
+"""Where the time goes, medians over every run of a group, failures included (s unless named): the set-up (every
+rung's builds); of the rung that gave the plan: its guess (an OMPL path's search, shortening, smoothing and timing),
+its solves and its dense verifications over every refinement round; `rest_s`, the rest of the computation (the
+other rungs tried, rebuilds, bookkeeping); the IPOPT iterations of every rung; the plan's rung's time per
+iteration (its solves over its iterations), its refinement rounds and screening rebuilds."""
+
+
 def summarize(rows: list[dict], by: tuple[str, ...]) -> list[dict]:
     """One summary row per distinct value of the `by` columns of results `rows`, sorted by those values (the rows'
     order, the order plans finished in, changes nothing): the group's names, then SUMMARY_COLUMNS (NaN where no run
     verified)."""
+    return [{**names, **_figures(group)} for names, group in _grouped(rows, by)]
+
+
+def time_split(rows: list[dict], by: tuple[str, ...]) -> list[dict]:
+    """One row per distinct value of the `by` columns, sorted as in `summarize`: the group's names, then
+    SPLIT_COLUMNS (NaN where no run records its timing in `extra`)."""
+    return [{**names, "runs": len(group), **_split(group)} for names, group in _grouped(rows, by)]
+
+
+def _grouped(rows: list[dict], by: tuple[str, ...]) -> list[tuple[dict, list[dict]]]:
+    """(the `by` columns' values, the rows with them) per distinct value, sorted by those values' text."""
     groups: dict[tuple, list[dict]] = {}
     for row in rows:
         groups.setdefault(tuple(row[c] for c in by), []).append(row)
     ordered = sorted(groups, key=lambda names: tuple(map(str, names)))
-    return [{**dict(zip(by, names)), **_figures(groups[names])} for names in ordered]
+    return [(dict(zip(by, names)), groups[names]) for names in ordered]
+
+
+def _split(rows: list[dict]) -> dict:
+    parts = [_parts(row) for row in rows]
+    return {name: float(np.nanmedian(values)) if not np.all(np.isnan(values := [p[name] for p in parts]))
+            else float("nan") for name in SPLIT_COLUMNS[1:]}
+
+
+GUESS_PARTS = ("guess", "path_search", "simplify", "smooth", "path_timing")
+"""The `timing` entries of a plan's `extra` that make its guess (the simultaneous planner's) or its path (a
+baseline's)."""
+
+
+def _parts(row: dict) -> dict:
+    """SPLIT_COLUMNS of one results row (after runs); without a timing in its `extra` (a plan that ended before
+    any solve, `no_path`) its whole computation is `rest_s` and the plan's rung's parts are NaN."""
+    extra = json.loads(row.get("extra") or "{}")
+    timing, nan = extra.get("timing"), float("nan")
+    rounds = (timing or {}).get("rounds") or []
+    guess = sum((timing or {}).get(name) or 0.0 for name in GUESS_PARTS) if timing else nan
+    solves = sum(r["solve"] for r in rounds) if timing else nan
+    verify = sum(r["verify"] for r in rounds) if timing else nan
+    iterations = sum(r["iterations"] for r in rounds)
+    explained = guess + solves + verify if timing else 0.0
+    return {"setup_s": float(row.get("setup_time_s") or 0.0), "guess_s": guess, "solves_s": solves,
+            "verify_s": verify, "rest_s": max(float(row["solve_time_s"]) - explained, 0.0),
+            "iterations": float(row.get("iterations") or 0), "rounds": float(len(rounds)) if timing else nan,
+            "ms_per_iteration": 1e3 * solves / iterations if iterations else nan,
+            "rebuilds": float((extra.get("screening") or {}).get("rebuilds", nan))}
 
 
 def _figures(rows: list[dict]) -> dict:

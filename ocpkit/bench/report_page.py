@@ -1,7 +1,8 @@
 """`ocpkit report DIR`: one self-contained HTML page (figures embedded as base64 PNG) and a Markdown summary of a
 `bench run` output folder, plus its OMPL benchmark logs for Planner Arena (ocpkit.bench.arena).
 
-Tables: the metrics (ocpkit.bench.metrics) per method and per method on each scene, success per method × scene.
+Tables: the metrics (ocpkit.bench.metrics) per method and per method on each scene, where the time goes per method
+on each scene (`time_split`), success per method × scene.
 Figures: the success grid, the computation-time distribution per method, t_f against computation time, and for
 one plan (`plan`: a trajectory file; default the first verified row's) joint position, velocity, torque and
 torque rate against their limits. The figures show every plan that found a trajectory (the tables: verified
@@ -24,7 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ocpkit.bench.arena import write_arena_logs  # noqa: E402
-from ocpkit.bench.metrics import formatted, success_grid, summarize  # noqa: E402
+from ocpkit.bench.metrics import formatted, success_grid, summarize, time_split  # noqa: E402
 from ocpkit.errors import OptionError  # noqa: E402
 from ocpkit.formats.scenario import load_scenario  # noqa: E402
 from ocpkit.robots import Robot  # noqa: E402
@@ -48,7 +49,9 @@ def write_report(folder: Path, plan: Path | None = None) -> tuple[Path, Path]:
     """report.html and report.md in `folder` (and planner-arena/*.log); returns the two paths."""
     rows = read_results(folder)
     chosen = _chosen(folder, rows, plan)
-    tables = {"Per method": summarize(rows, ("method",)), "Per method and scene": summarize(rows, ("method", "scene"))}
+    tables = {"Per method": summarize(rows, ("method",)), "Per method and scene": summarize(rows, ("method", "scene")),
+              "Where the time goes, per method and scene (medians over every plan)": time_split(
+                  rows, ("method", "scene"))}
     methods, scenes, rates = success_grid(rows)
     figures = {"Success per method and scene (%)": _success_figure(methods, scenes, rates),
                "Computation time per method": _time_figure(rows, methods),

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from ocpkit.bench.metrics import end_effector_positions, plan_metrics, success_grid, summarize
+from ocpkit.bench.metrics import end_effector_positions, plan_metrics, success_grid, summarize, time_split
 from ocpkit.formats.trajectory import Samples
 from ocpkit.robots import load_robot
 
@@ -94,3 +96,23 @@ def test_the_tables_do_not_depend_on_the_order_the_plans_finished_in():
     forward, backward = success_grid(rows), success_grid(rows[::-1])
     assert forward[:2] == backward[:2] == (["a", "b"], ["s1", "s2"])
     np.testing.assert_array_equal(forward[2], backward[2])
+
+
+def timed(time: float, guess: float, rounds: list[tuple[float, float, int]], rebuilds: int = 0) -> dict:
+    """A results row whose `extra` records a guess of `guess` s and (solve s, verify s, iterations) per round."""
+    timing = {"guess": guess, "rounds": [{"solve": s, "verify": v, "iterations": k} for s, v, k in rounds]}
+    extra = {"timing": timing, "screening": {"rows_per_point": 50, "rebuilds": rebuilds}}
+    return {**row("a", "s1", "verified", time, setup=0.8), "iterations": str(sum(k for _, _, k in rounds) + 7),
+            "extra": json.dumps(extra)}
+
+
+def test_the_time_split_adds_up_to_the_computation_and_takes_medians_over_every_plan():
+    rows = [timed(4.0, 1.0, [(1.5, 0.2, 30), (0.5, 0.1, 10)], rebuilds=1), timed(2.0, 0.5, [(1.0, 0.1, 20)]),
+            {**row("a", "s1", "no_path", 30.0, setup=1.2), "iterations": "0", "extra": json.dumps({"rungs": []})}]
+    (split,) = time_split(rows, ("method", "scene"))
+    assert (split["method"], split["scene"], split["runs"]) == ("a", "s1", 3)
+    assert split["setup_s"] == 0.8 and split["guess_s"] == 0.75 and split["solves_s"] == 1.5
+    assert split["verify_s"] == pytest.approx(0.2) and split["rounds"] == 1.5  # NaN for the plan without a solve
+    assert split["rest_s"] == pytest.approx(0.7)  # 4 - 1 - 2 - 0.3 = 0.7, 2 - 0.5 - 1 - 0.1 = 0.4, 30 (no timing)
+    assert split["ms_per_iteration"] == pytest.approx(50.0) and split["iterations"] == 27.0
+    assert split["rebuilds"] == 0.5
