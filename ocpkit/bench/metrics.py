@@ -110,19 +110,20 @@ baseline's)."""
 def _parts(row: dict) -> dict:
     """SPLIT_COLUMNS of one results row (after runs); without a timing in its `extra` (a plan that ended before
     any solve, `no_path`) its whole computation is `rest_s` and the plan's rung's parts are NaN."""
-    extra = json.loads(row.get("extra") or "{}")
-    timing, nan = extra.get("timing"), float("nan")
-    rounds = (timing or {}).get("rounds") or []
-    guess = sum((timing or {}).get(name) or 0.0 for name in GUESS_PARTS) if timing else nan
-    solves = sum(r["solve"] for r in rounds) if timing else nan
-    verify = sum(r["verify"] for r in rounds) if timing else nan
+    extra, nan = json.loads(row.get("extra") or "{}"), float("nan")
+    known = {"setup_s": float(row.get("setup_time_s") or 0.0), "iterations": float(row.get("iterations") or 0),
+             "rebuilds": float((extra.get("screening") or {}).get("rebuilds", nan))}
+    timing, computation = extra.get("timing"), float(row["solve_time_s"])
+    if not timing:
+        return {**known, "guess_s": nan, "solves_s": nan, "verify_s": nan, "rest_s": computation, "rounds": nan,
+                "ms_per_iteration": nan}
+    rounds = timing.get("rounds") or []
+    guess = sum(timing.get(name) or 0.0 for name in GUESS_PARTS)
+    solves, verify = sum(r["solve"] for r in rounds), sum(r["verify"] for r in rounds)
     iterations = sum(r["iterations"] for r in rounds)
-    explained = guess + solves + verify if timing else 0.0
-    return {"setup_s": float(row.get("setup_time_s") or 0.0), "guess_s": guess, "solves_s": solves,
-            "verify_s": verify, "rest_s": max(float(row["solve_time_s"]) - explained, 0.0),
-            "iterations": float(row.get("iterations") or 0), "rounds": float(len(rounds)) if timing else nan,
-            "ms_per_iteration": 1e3 * solves / iterations if iterations else nan,
-            "rebuilds": float((extra.get("screening") or {}).get("rebuilds", nan))}
+    return {**known, "guess_s": guess, "solves_s": solves, "verify_s": verify,
+            "rest_s": max(computation - guess - solves - verify, 0.0), "rounds": float(len(rounds)),
+            "ms_per_iteration": 1e3 * solves / iterations if iterations else nan}
 
 
 def _figures(rows: list[dict]) -> dict:
