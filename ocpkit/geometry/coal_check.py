@@ -1,11 +1,17 @@
-"""The sphere model's yes/no collision test in C++: pinocchio's kinematics and coal's narrow phase.
+"""The sphere model's yes/no collision test in C++: pinocchio's kinematics, coal's broad and narrow phases.
 
 `CoalCheck(robot, scene, margin)` answers what `clearances(...) >= margin` answers (ocpkit.geometry.clearances,
 the verifier's model), for many configurations in one call: the robot's spheres become coal spheres on their
-joints, the obstacles coal spheres, boxes and cylinders fixed in the world, the workspace's six faces half-spaces
-(the region outside each face), and every checked pair (the robot's self-collision pairs, each sphere against each
-obstacle and face) carries `margin` as coal's security margin, so a pair counts as colliding when its clearance is
-below the margin. It is the path search's test (ocpkit.planner.ompl_seed); `verify` keeps the NumPy reference.
+joints, the obstacles coal spheres, boxes and cylinders fixed in the world, the region beyond each of the
+workspace's six faces a large box (`_world_shapes`). The checked pairs are the robot's self-collision pairs and
+each sphere against each obstacle and face. It is the path search's test (ocpkit.planner.ompl_seed); `verify`
+keeps the NumPy reference.
+
+A broad phase (coal's dynamic AABB tree, through pinocchio's broad-phase manager) hands the narrow phase only the
+pairs whose bounding boxes overlap. For that to be exact, every robot sphere is grown by i = max(margin, 0) and
+each pair's security margin (coal counts a pair as colliding when its distance is below it) takes the rest:
+margin − i for a sphere against an obstacle, margin − 2i for two spheres. Both are ≤ 0, so a pair that counts as
+colliding overlaps its grown boxes, and its clearance is below `margin` exactly when coal says it collides.
 """
 
 from __future__ import annotations
@@ -18,13 +24,17 @@ from ocpkit.geometry.scene import Scene
 from ocpkit.robots import Robot
 
 
+SLAB = 1e3  # m: the edge of the cube standing in for the half-space beyond a workspace face (`_world_shapes`)
+
+
 class CoalCheck:
     """Collision tests of `robot` in `scene` keeping `margin` (m) of clearance."""
 
     def __init__(self, robot: Robot, scene: Scene, margin: float) -> None:
+        grown = max(margin, 0.0)
         model = pin.GeometryModel()
         spheres = [model.addGeometryObject(pin.GeometryObject(
-            f"sphere {m}", int(joint), pin.SE3(np.eye(3), offset), coal.Sphere(float(radius))))
+            f"sphere {m}", int(joint), pin.SE3(np.eye(3), offset), coal.Sphere(float(radius) + grown)))
             for m, (joint, offset, radius) in enumerate(zip(robot.sphere_joint, robot.sphere_offset,
                                                              robot.sphere_radius))]
         fixed = [model.addGeometryObject(pin.GeometryObject(name, 0, pose, shape))
@@ -34,10 +44,11 @@ class CoalCheck:
         for sphere in spheres:
             for body in fixed:
                 model.addCollisionPair(pin.CollisionPair(sphere, body))
-        self.pool = pin.GeometryPool(robot.model, model, 1)
+        self.pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(robot.model, model, 1)
+        grown_pair = [2 * grown if pair.second < len(spheres) else grown for pair in model.collisionPairs]
         for data in self.pool.getGeometryDatas():
-            for request in data.collisionRequests:
-                request.security_margin = margin
+            for request, taken in zip(data.collisionRequests, grown_pair):
+                request.security_margin = margin - taken
                 request.enable_contact = False
 
     def free(self, q: np.ndarray) -> np.ndarray:
@@ -58,8 +69,10 @@ class CoalCheck:
 
 
 def _world_shapes(scene: Scene) -> list[tuple[str, pin.SE3, coal.CollisionGeometry]]:
-    """(name, pose in the world, coal shape) of every obstacle and, with a workspace, of the half-space beyond each
-    of its faces."""
+    """(name, pose in the world, coal shape) of every obstacle and, with a workspace, of the region beyond each of
+    its faces: a cube of edge SLAB against the face, centred on the workspace's centre across it, the same as the
+    half-space for every sphere within SLAB / 2 of that centre, which is every sphere a robot can reach. (coal's
+    Halfspace has an unbounded box, which its AABB tree misses.)"""
     shapes = [("sphere", pin.SE3(np.eye(3), c), coal.Sphere(float(r)))
               for c, r in zip(scene.obstacle_centers, scene.obstacle_radii)]
     shapes += [("box", pin.SE3(rotation, c), coal.Box(*map(float, size)))
@@ -69,7 +82,9 @@ def _world_shapes(scene: Scene) -> list[tuple[str, pin.SE3, coal.CollisionGeomet
                for c, r, length, rotation in zip(cylinders.centers, cylinders.radii, cylinders.lengths,
                                                  cylinders.rotations)]
     if scene.workspace is not None:
-        for axis, normal in enumerate(np.eye(3)):  # coal's Halfspace(n, d) is the solid n·x ≤ d
-            shapes.append(("below", pin.SE3.Identity(), coal.Halfspace(normal, float(scene.workspace.lower[axis]))))
-            shapes.append(("above", pin.SE3.Identity(), coal.Halfspace(-normal, -float(scene.workspace.upper[axis]))))
+        lower, upper = scene.workspace.lower, scene.workspace.upper
+        for axis, normal in enumerate(np.eye(3)):
+            for name, face, side in (("below", lower[axis], -1.0), ("above", upper[axis], 1.0)):
+                center = (lower + upper) / 2 + normal * (face + side * SLAB / 2 - (lower + upper)[axis] / 2)
+                shapes.append((name, pin.SE3(np.eye(3), center), coal.Box(SLAB, SLAB, SLAB)))
     return shapes

@@ -27,15 +27,17 @@ def problems() -> list[tuple[str, ocpkit.Problem]]:
     return loaded + [("random industrial6 (spheres, a workspace)", list(random_problems(500, 1))[0])]
 
 
+@pytest.mark.parametrize("margin", [MARGIN, 0.0, -0.02])  # the broad phase's grown spheres: margin > 0, = 0, < 0
 @pytest.mark.parametrize("name,problem", problems(), ids=lambda v: v if isinstance(v, str) else "")
-def test_coal_answers_what_the_clearances_answer(name, problem):
+def test_coal_answers_what_the_clearances_answer(name, problem, margin):
     robot = problem.robot
     q = np.random.default_rng(3).uniform(robot.q_lower, robot.q_upper, (1500, robot.n))
     smallest = smallest_clearance(problem, q)
-    decided = np.abs(smallest - MARGIN) > 1e-9  # coal's distances round differently within a nanometre
-    assert 0.1 < (smallest >= MARGIN).mean() < 0.95  # both answers occur
-    got = CoalCheck(robot, problem.scene, MARGIN).free(q)
-    np.testing.assert_array_equal(got[decided], (smallest >= MARGIN)[decided])
+    decided = np.abs(smallest - margin) > 1e-9  # coal's distances round differently within a nanometre
+    assert 0.1 < (smallest >= margin).mean() < 0.95  # both answers occur
+    assert (np.abs(smallest - margin) < 0.01).sum() >= 10  # and near misses either side of the margin
+    got = CoalCheck(robot, problem.scene, margin).free(q)
+    np.testing.assert_array_equal(got[decided], (smallest >= margin)[decided])
 
 
 def test_the_first_collision_along_a_batch_is_found_and_the_rest_skipped():
