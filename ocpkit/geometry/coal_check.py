@@ -83,8 +83,9 @@ def _world_shapes(scene: Scene) -> list[tuple[str, pin.SE3, coal.CollisionGeomet
                                                  cylinders.rotations)]
     if scene.workspace is not None:
         lower, upper = scene.workspace.lower, scene.workspace.upper
-        for axis, normal in enumerate(np.eye(3)):
+        for axis in range(3):
             for name, face, side in (("below", lower[axis], -1.0), ("above", upper[axis], 1.0)):
-                center = (lower + upper) / 2 + normal * (face + side * SLAB / 2 - (lower + upper)[axis] / 2)
+                center = (lower + upper) / 2
+                center[axis] = face + side * SLAB / 2
                 shapes.append((name, pin.SE3(np.eye(3), center), coal.Box(SLAB, SLAB, SLAB)))
     return shapes
