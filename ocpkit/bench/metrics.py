@@ -97,9 +97,15 @@ def _grouped(rows: list[dict], by: tuple[str, ...]) -> list[tuple[dict, list[dic
 
 
 def _split(rows: list[dict]) -> dict:
+    """SPLIT_COLUMNS after runs: each the median over the rows that have it (`_parts`), NaN where none has."""
     parts = [_parts(row) for row in rows]
-    return {name: float(np.nanmedian(values)) if not np.all(np.isnan(values := [p[name] for p in parts]))
-            else float("nan") for name in SPLIT_COLUMNS[1:]}
+    return {name: _median_known([p[name] for p in parts]) for name in SPLIT_COLUMNS[1:]}
+
+
+def _median_known(values: list[float]) -> float:
+    """The median of `values` without their NaNs; NaN if all are."""
+    known = [v for v in values if not np.isnan(v)]
+    return float(np.median(known)) if known else float("nan")
 
 
 GUESS_PARTS = ("guess", "path_search", "simplify", "smooth", "path_timing")
