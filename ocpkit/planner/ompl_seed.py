@@ -79,13 +79,14 @@ FOUND_PATHS = 4  # paths kept for a repeated search (`ompl_path`)
 class FreeSpace:
     """The verifier's collision model as a yes/no test: free iff every clearance is ≥ `margin` (m).
 
-    `free` and `segment_free` ask coal (ocpkit.geometry.coal_check, the same answers in C++), `clearance` the
-    NumPy reference. Counts the configurations it has tested (`checks`)."""
+    `free`, `segment_free` and `keeps` ask coal (ocpkit.geometry.coal_check, the same answers in C++), `clearance`
+    the NumPy reference. Counts the configurations it has tested (`checks`)."""
 
     def __init__(self, problem: Problem, margin: float) -> None:
         self.robot, self.scene, self.margin = problem.robot, problem.scene, margin
         self.data = problem.robot.model.createData()
         self.coal = CoalCheck(problem.robot, problem.scene, margin)
+        self._other_margins: dict[float, CoalCheck] = {}
         self.checks = 0
 
     def clearance(self, q: np.ndarray) -> np.ndarray:
@@ -99,6 +100,13 @@ class FreeSpace:
         """Whether each configuration of q (K, n) keeps the margin: shape (K,), bool."""
         self.checks += len(q)
         return self.coal.free(q)
+
+    def keeps(self, q: np.ndarray, margin: float) -> np.ndarray:
+        """Whether each configuration of q (K, n) keeps `margin` (m) instead of the space's own: shape (K,), bool."""
+        if margin not in self._other_margins:
+            self._other_margins[margin] = CoalCheck(self.robot, self.scene, margin)
+        self.checks += len(q)
+        return self._other_margins[margin].free(q)
 
     def segment_free(self, a: np.ndarray, b: np.ndarray, resolution: float) -> bool:
         """Whether the straight segment a → b (n,) is free at configurations at most `resolution` rad apart.
@@ -317,7 +325,7 @@ def smooth_path(waypoints: np.ndarray, free: FreeSpace, resolution: float,
         checks = np.linspace(0.0, chord[-1], int(np.ceil(4 * chord[-1] / resolution)) + 1)
         q = path(checks)
         outside = ((q < free.robot.q_lower) | (q > free.robot.q_upper)).any(axis=1) if within_limits else False
-        bad = checks[(free.clearance(q) < free.margin / 2) | outside]
+        bad = checks[~free.keeps(q, free.margin / 2) | outside]
         if not len(bad) or rounds == REPAIR_ROUNDS:
             break
         segments = np.unique(np.clip(np.searchsorted(chord, bad) - 1, 0, len(chord) - 2))

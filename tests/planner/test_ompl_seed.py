@@ -147,3 +147,16 @@ def test_a_search_budgeted_in_time_or_in_fewer_checks_than_the_path_took_searche
                                        0.02, max_checks=1)
     assert short.path_time > 0.0  # searched, not reused
     assert ompl_seed_module.ompl_path(case1, free, "rrtconnect", 0.0, 5, 0.02).waypoints is None
+
+
+@pytest.mark.parametrize("margin", [0.005, 0.0])
+def test_keeps_answers_what_the_clearances_answer_at_another_margin_and_counts_its_checks(case1, margin):
+    free = ompl_seed_module.planning_space(case1, 0.01)
+    rng = np.random.default_rng(3)
+    q = rng.uniform(case1.robot.q_lower, case1.robot.q_upper, size=(400, case1.robot.n))
+    reference = free.clearance(q) >= margin
+    before = free.checks
+    kept = free.keeps(q, margin)
+    assert free.checks == before + len(q)
+    assert 0 < kept.sum() < len(q)  # both answers occur
+    np.testing.assert_array_equal(kept, reference)
