@@ -4,8 +4,9 @@ A `Rung` is a small set of option overrides (initial guess and OMPL seed, knots,
 solve), and `Rung.apply` is how it changes the options of the call (ocpkit.planner.options.SimultaneousOptions).
 `climb` plans rung after rung within one wall-time budget and returns the first verified plan, else the best one
 (`rank`), with every rung's name, status, time and iterations in `stats.rungs`. A rung that only lifts the
-iteration cap of an earlier one is skipped (listed in `stats.skipped`) unless that one stopped at its cap: it
-would repeat the same solve. An empty ladder plans once with the call's options (the paper's single shot).
+iteration cap of an earlier one is skipped (listed in `stats.skipped`) unless that one stopped at its cap or its
+share of the time: it would repeat the same solve. An empty ladder plans once with the call's options (the
+paper's single shot).
 
 Why these rungs: the straight line verifies most problems within a few hundred IPOPT iterations, and
 one that has not converged by then usually ends infeasible or at the iteration limit after many seconds, so the
@@ -31,7 +32,10 @@ line after the first OMPL rung, whose path starts clear of the obstacles.
 
 The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an OMPL rung on a hard problem
 (MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified
-plan returns at once; the budget is what a failure costs. A ladder that verifies nothing, where every OMPL rung
+plan returns at once; the budget is what a failure costs. A capped rung (one with an iteration cap) also gets at
+most RUNG_SHARE of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP)
+then ends by time, not after the whole budget, so the safety net and another rung still get their turn. A ladder
+that verifies nothing, where every OMPL rung
 found no path, ends `no_path`, with the configurations the last search checked: where the obstacles leave no way
 through, that is the evidence, and no failed solve says more.
 
@@ -39,7 +43,9 @@ The safety net (`Rung.safety_net`, after the first OMPL rung): where that rung f
 verify, ompl-topp3 times the same path (reused, not searched again: ocpkit.planner.ompl_seed) along its fixed
 geometry under every limit, a motion that usually verifies, slower than an optimal one. Its verified plan does not
 stop the ladder, which climbs on for a plan that is optimal in path and timing together; it is the answer only when
-no other rung verifies (anytime: the best certified plan found within the budget, its rung named).
+no other rung verifies (anytime: the best certified plan found within the budget, its rung named). With that
+plan in hand the ladder climbs on only while a capped rung's share of the budget is left: a rung that could not
+have its share is not worth the wait for an answer already certified.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
@@ -68,6 +74,7 @@ MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the si
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
+RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take; a certified plan in hand ends the climb below it
 
 
 @dataclass(frozen=True)
@@ -179,21 +186,29 @@ def rank(plan: Plan) -> tuple[int, float]:
 
 
 def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:
-    """Plan with `attempt(rung, seconds left)` on each rung of `ladder` in turn, each followed by its `finer` rung
-    when its plan calls for one (on None once if the ladder is empty), until one that is not a safety net verifies
-    or the `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than the last
-    rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module docstring). A
-    safety net runs only where an OMPL rung of its seed found a path."""
+    """Plan with `attempt(rung, seconds it may take)` on each rung of `ladder` in turn, each followed by its `finer`
+    rung when its plan calls for one (on None once if the ladder is empty), until one that is not a safety net
+    verifies or the `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than
+    the last rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module
+    docstring). A rung may take the time left, a capped one at most RUNG_SHARE of `max_wall_time`; once a safety
+    net has verified, no rung starts with less than that share left. A safety net runs only where an OMPL rung of
+    its seed found a path."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
     skipped: list[str] = []
+    share = RUNG_SHARE * max_wall_time
 
     def left() -> float:
         return max_wall_time - sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
 
     def room() -> bool:  # time for at least a build as long as the last one: a rung that cannot build only overruns
+        if any(p.ok for _, p in tried) and left() < share:  # a certified plan in hand: a rung's share or nothing
+            return False
         return not tried or left() > tried[-1][1].stats.setup_time
+
+    def allowed(rung: Rung) -> float:  # the seconds `rung` may take
+        return max(min(left(), share) if rung.max_iterations is not None else left(), 0.0)
 
     for rung in ladder:
         if not room():
@@ -201,9 +216,9 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
         if _repeats(rung, tried) or (rung.safety_net and not _path_found(rung.seed, tried)):
             skipped.append(rung.name)
             continue
-        tried.append((rung, attempt(rung, max(left(), 0.0))))
+        tried.append((rung, attempt(rung, allowed(rung))))
         if (next_rung := finer(*tried[-1])) is not None and room():
-            tried.append((next_rung, attempt(next_rung, left())))
+            tried.append((next_rung, attempt(next_rung, allowed(next_rung))))
         if tried[-1][1].ok and not tried[-1][0].safety_net:
             break
     return _combined(tried, skipped)
@@ -221,11 +236,11 @@ def finer(rung: Rung, plan: Plan) -> Rung | None:
 
 def _repeats(rung: Rung, tried: list[tuple[Rung, Plan]]) -> bool:
     """Whether `rung` is an earlier rung with only another iteration cap, and that one stopped short of its cap
-    (any status but iteration_limit): the solve would repeat itself."""
+    and of its share of the time (any status but iteration_limit and time_limit): the solve would repeat itself."""
     def solve(r: Rung) -> Rung:
         return dataclasses.replace(r, name="", max_iterations=None)
 
-    return any(solve(r) == solve(rung) and p.status != "iteration_limit" for r, p in tried)
+    return any(solve(r) == solve(rung) and p.status not in ("iteration_limit", "time_limit") for r, p in tried)
 
 
 def _path_found(seed: int | None, tried: list[tuple[Rung, Plan]]) -> bool:

@@ -22,7 +22,7 @@ from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
 from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_RESOLUTION,
-                                   SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
+                                   RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow
@@ -124,6 +124,24 @@ def test_every_rung_gets_the_time_left_and_none_starts_after_the_budget():
     result = climb(script, LADDER, 8.0)
     assert script.calls == [("a", 8.0), ("b", 2.5)]  # a's 5 s of computation and 0.5 s of set-up spent
     assert result.status == "infeasible" and result.method["rung"] == "a"
+
+
+def test_a_capped_rung_takes_at_most_its_share_of_the_budget_and_one_stopped_by_it_is_tried_uncapped():
+    capped = (Rung("a", max_iterations=300), Rung("b", guess="ompl", seed=1), Rung("a-uncapped"))
+    script = Script({"a": fake("time_limit", seconds=15.0), "b": fake("infeasible", seconds=4.0),
+                     "a-uncapped": fake("verified")})
+    result = climb(script, capped, 30.0)
+    assert script.calls == [("a", RUNG_SHARE * 30.0), ("b", 14.5), ("a-uncapped", 10.0)]
+    assert result.method["rung"] == "a-uncapped" and result.stats.skipped == ()
+
+
+@pytest.mark.parametrize("net_seconds, climbs_on", [(2.0, True), (12.0, False)])
+def test_with_a_verified_safety_net_the_ladder_climbs_on_only_while_a_rungs_share_is_left(net_seconds, climbs_on):
+    script = Script({"a": fake("infeasible", seconds=4.0), "b": fake("iteration_limit", seconds=4.0),
+                     "net": fake("verified", seconds=net_seconds), "c": fake("verified")})
+    result = climb(script, NETTED, 30.0)  # 30 − 3 × 0.5 s of set-up − 8 s − the net's: 18.5 s or 8.5 s left
+    assert [name for name, _ in script.calls] == ["a", "b", "net", *(["c"] if climbs_on else [])]
+    assert result.ok and result.method["rung"] == ("c" if climbs_on else "net")
 
 
 def test_no_rung_starts_with_less_time_left_than_the_last_build_took():
@@ -348,7 +366,7 @@ def test_a_plan_violated_only_by_the_dynamics_residual_is_re_solved_on_a_finer_g
     script = Recording({"a": fake("violated", 0.02, seconds=5.0, check="dynamics", trajectory=motion),
                         "a-finer": fake("verified", seconds=2.0), "b": fake("verified")})
     result = climb(script, LADDER, 20.0)
-    assert script.calls == [("a", 20.0), ("a-finer", 14.5)]
+    assert script.calls == [("a", 20.0), ("a-finer", 10.0)]  # a finer rung is capped: half the budget at most
     assert script.rungs[1].refines is motion and script.rungs[1].knots == LADDER[0].knots
     assert result.ok and result.method["rung"] == "a-finer"
 
