@@ -28,7 +28,7 @@ from ocpkit.problem import Problem
 
 SCREEN_DISTANCE = 0.2  # m: a term is kept when its clearance is below this somewhere near the motion
 CROWDED_ROWS = 64  # rows per point above which an NLP is crowded: screened at CROWDED_DISTANCE instead
-CROWDED_DISTANCE = 0.1  # m
+CROWDED_DISTANCE = 0.05  # m
 MISSING_FRACTION = 0.5  # a left-out term within this fraction of the screening distance triggers a rebuild
 MAX_REBUILDS = 3
 SAMPLES = 64  # configurations sampled along a motion (evenly in time)
