@@ -35,9 +35,8 @@ The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an 
 plan returns at once; the budget is what a failure costs. A capped rung (one with an iteration cap) also gets at
 most RUNG_SHARE of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP)
 then ends by time, not after the whole budget, so the safety net and another rung still get their turn. A ladder
-that verifies nothing, where every OMPL rung
-found no path, ends `no_path`, with the configurations the last search checked: where the obstacles leave no way
-through, that is the evidence, and no failed solve says more.
+that verifies nothing, where every OMPL rung found no path, ends `no_path`, with the configurations the last
+search checked: where the obstacles leave no way through, that is the evidence, and no failed solve says more.
 
 The safety net (`Rung.safety_net`, after the first OMPL rung): where that rung found a path but its solve did not
 verify, ompl-topp3 times the same path (reused, not searched again: ocpkit.planner.ompl_seed) along its fixed
@@ -86,7 +85,7 @@ class Rung:
     `relaxed`: a continuation, solving the problem relaxed (ocpkit.planner.refinement.RELAXED) first to warm-start
     the real one, and `refines`: a motion to re-solve on a finer grid than the rung's own (`finer`), its guess
     instead of `guess`. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the
-    ladder's time is up. A `safety_net` rung (guess "ompl") plans with ompl-topp3 instead, on the OMPL path of
+    rung's time is up. A `safety_net` rung (guess "ompl") plans with ompl-topp3 instead, on the OMPL path of
     its `seed` (module docstring); the simultaneous planner runs it, not `apply`."""
 
     name: str
@@ -103,7 +102,7 @@ class Rung:
         """`options` with this rung's overrides. A rung's guess comes with its own options instead of the call's:
         its seed, and no fallback to the straight line (a rung without a start of its own ends `no_path` instead
         of repeating the line); an "ompl" rung's search stops after OMPL_CHECKS configurations or the `left`
-        seconds of the ladder. `knots` and `segments` apply to a pseudospectral transcription; one without
+        seconds the rung may take. `knots` and `segments` apply to a pseudospectral transcription; one without
         segments keeps the call's grid on a rung with segments. The call's own max_iterations wins over the
         rung's cap, which caps each solve and, as the iteration budget, the rung's refinement rounds and
         rebuilds. A rung that `refines` a motion starts from it on the finer grid (`finer_grid`)."""
@@ -202,10 +201,10 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     def left() -> float:
         return max_wall_time - sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
 
-    def room() -> bool:  # time for at least a build as long as the last one: a rung that cannot build only overruns
-        if any(p.ok for _, p in tried) and left() < share:  # a certified plan in hand: a rung's share or nothing
-            return False
-        return not tried or left() > tried[-1][1].stats.setup_time
+    def room() -> bool:  # time for a build as long as the last one (a rung that cannot build only overruns), and
+        # with a certified plan in hand (a safety net's) for a whole share: a shorter rung is not worth the wait
+        certified = any(p.ok for _, p in tried)
+        return not tried or left() > max(tried[-1][1].stats.setup_time, share if certified else 0.0)
 
     def allowed(rung: Rung) -> float:  # the seconds `rung` may take
         return max(min(left(), share) if rung.max_iterations is not None else left(), 0.0)
