@@ -86,7 +86,7 @@ class FreeSpace:
         self.robot, self.scene, self.margin = problem.robot, problem.scene, margin
         self.data = problem.robot.model.createData()
         self.coal = CoalCheck(problem.robot, problem.scene, margin)
-        self._other_margins: dict[float, CoalCheck] = {}
+        self._by_margin = {margin: self.coal}  # a CoalCheck per margin asked (`keeps`), made on first use
         self.checks = 0
 
     def clearance(self, q: np.ndarray) -> np.ndarray:
@@ -98,15 +98,14 @@ class FreeSpace:
 
     def free(self, q: np.ndarray) -> np.ndarray:
         """Whether each configuration of q (K, n) keeps the margin: shape (K,), bool."""
-        self.checks += len(q)
-        return self.coal.free(q)
+        return self.keeps(q, self.margin)
 
     def keeps(self, q: np.ndarray, margin: float) -> np.ndarray:
-        """Whether each configuration of q (K, n) keeps `margin` (m) instead of the space's own: shape (K,), bool."""
-        if margin not in self._other_margins:
-            self._other_margins[margin] = CoalCheck(self.robot, self.scene, margin)
+        """Whether each configuration of q (K, n) keeps `margin` (m), the space's own or another: shape (K,), bool."""
+        if margin not in self._by_margin:
+            self._by_margin[margin] = CoalCheck(self.robot, self.scene, margin)
         self.checks += len(q)
-        return self._other_margins[margin].free(q)
+        return self._by_margin[margin].free(q)
 
     def segment_free(self, a: np.ndarray, b: np.ndarray, resolution: float) -> bool:
         """Whether the straight segment a → b (n,) is free at configurations at most `resolution` rad apart.
