@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ocpkit.formats.trajectory import TIME_TOLERANCE, Samples, Trajectory, time_excess
-from ocpkit.geometry.clearances import clearances, sphere_centers_batch
+from ocpkit.geometry.nearest import smallest_clearances
 from ocpkit.problem import Problem
 from ocpkit.robots import rigid_torque
 from ocpkit.tolerances import (BOUNDARY_TOLERANCE, DYNAMICS_TOLERANCE, GEOMETRY_TOLERANCE, LIMIT_TOLERANCE,
@@ -109,8 +109,8 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
         "torque_rate": (np.abs(samples.taud) / robot.taud_max - 1.0, LIMIT_TOLERANCE, "rel"),
     }
     consistency = np.abs(samples.tau - tau_needed) / (2.0 * robot.tau_max)
-    c = clearances(robot, problem.scene, sphere_centers_batch(robot, samples.q))
-    penetration = dict(zip(GEOMETRY_CHECKS, (-c.self_pairs, -c.obstacles, -c.workspace)))
+    nearest = smallest_clearances(robot, problem.scene, samples.q)
+    penetration = dict(zip(GEOMETRY_CHECKS, (-nearest.self_pairs, -nearest.obstacles, -nearest.workspace)))
     checks = [_worst(name, v, tolerance, samples.t, unit, robot.joint_names)
               for name, (v, tolerance, unit) in excess.items()]
     checks.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))

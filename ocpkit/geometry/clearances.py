@@ -73,6 +73,12 @@ def sphere_centers_batch(robot: Robot, qs: np.ndarray) -> np.ndarray:
     """`sphere_centers` of many configurations qs (K, n) at once, shape (K, M, 3): the joint poses composed in
     numpy over all K together (revolute and prismatic 1-DoF joints, the ones ocpkit models), instead of one
     pinocchio forward-kinematics call per configuration; the same numbers (tests/geometry/test_clearances.py)."""
+    return points_on_joints(robot, qs, robot.sphere_joint, robot.sphere_offset)
+
+
+def points_on_joints(robot: Robot, qs: np.ndarray, joints: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """World positions (K, P, 3) of P points, point p fixed at offsets[p] (m) in the frame of joint joints[p], at
+    configurations qs (K, n): `sphere_centers_batch` for any points on the robot."""
     qs = np.atleast_2d(np.asarray(qs, dtype=float))
     rotation = np.empty((robot.model.njoints, len(qs), 3, 3))
     translation = np.empty((robot.model.njoints, len(qs), 3))
@@ -87,8 +93,8 @@ def sphere_centers_batch(robot: Robot, qs: np.ndarray) -> np.ndarray:
             rotation[j] = rotation[joint.parent] @ joint.rotation
             local_t = joint.translation + joint.slide * q[:, None]
         translation[j] = translation[joint.parent] + (rotation[joint.parent] @ local_t[..., None])[..., 0]
-    r, t = rotation[robot.sphere_joint], translation[robot.sphere_joint]  # (M, K, 3, 3), (M, K, 3)
-    return (np.einsum("mkij,mj->kmi", r, robot.sphere_offset) + t.transpose(1, 0, 2))
+    r, t = rotation[joints], translation[joints]  # (P, K, 3, 3), (P, K, 3)
+    return np.einsum("pkij,pj->kpi", r, offsets) + t.transpose(1, 0, 2)
 
 
 @dataclass(frozen=True)

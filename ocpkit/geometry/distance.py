@@ -27,15 +27,37 @@ def _signed(excess: np.ndarray) -> np.ndarray:
     return np.sqrt(np.einsum("...i,...i->...", outside, outside)) + np.minimum(excess.max(axis=-1), 0.0)
 
 
+def _own_local(points: np.ndarray, centers: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """Points (k, w, 3), row i in the frame of primitive i (centers (k, 3), rotations (k, 3, 3)): shape (k, w, 3)."""
+    return np.einsum("kji,kwj->kwi", rotations, points - centers[:, None])
+
+
 def box_distance(points: np.ndarray, boxes: Boxes) -> np.ndarray:
     """Signed distance of points (..., 3) to each box: shape (..., B)."""
     p = _local(points, boxes.centers, boxes.rotations)
     return _signed(np.abs(p) - 0.5 * boxes.sizes)
 
 
+def box_distance_each(points: np.ndarray, boxes: Boxes, which: np.ndarray) -> np.ndarray:
+    """Signed distance of points (k, w, 3), row i to box which[i] (k,) only: shape (k, w)."""
+    p = _own_local(points, boxes.centers[which], boxes.rotations[which])
+    return _signed(np.abs(p) - 0.5 * boxes.sizes[which][:, None])
+
+
 def cylinder_distance(points: np.ndarray, cylinders: Cylinders) -> np.ndarray:
     """Signed distance of points (..., 3) to each cylinder: shape (..., C)."""
     p = _local(points, cylinders.centers, cylinders.rotations)
-    radial = np.linalg.norm(p[..., :2], axis=-1) - cylinders.radii
-    axial = np.abs(p[..., 2]) - 0.5 * cylinders.lengths
+    return _cylinder(p, cylinders.radii, cylinders.lengths)
+
+
+def cylinder_distance_each(points: np.ndarray, cylinders: Cylinders, which: np.ndarray) -> np.ndarray:
+    """Signed distance of points (k, w, 3), row i to cylinder which[i] (k,) only: shape (k, w)."""
+    p = _own_local(points, cylinders.centers[which], cylinders.rotations[which])
+    return _cylinder(p, cylinders.radii[which][:, None], cylinders.lengths[which][:, None])
+
+
+def _cylinder(p: np.ndarray, radii: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """Signed distance of points p (..., 3) in cylinders' frames, radii and lengths broadcasting over p[..., 0]."""
+    radial = np.linalg.norm(p[..., :2], axis=-1) - radii
+    axial = np.abs(p[..., 2]) - 0.5 * lengths
     return _signed(np.stack([radial, axial], axis=-1))
