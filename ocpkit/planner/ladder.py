@@ -20,7 +20,10 @@ polynomial of degree 12 leaves it between knots. Their path search is budgeted i
 (OMPL_CHECKS, the budget the random suite certifies room to pass with), so whether it finds a path does not depend
 on the machine's speed; its edges are checked every OMPL_RESOLUTION rad, twice the seed's default spacing: the
 path is only a start, which the solve and the dense verification make exact, and in MBM's cages the search with
-the finer spacing took most of the budget. More knots resolve what a coarse grid leaves violated. The
+the finer spacing took most of the budget. The search is RRTConnect, and LBKPIECE1 where RRTConnect has found no
+path within a few seconds' checks (OMPL_PLANNER: ocpkit.planner.ompl_seed): in MBM's cages and shelves, and on the
+Fetch, RRTConnect often took hundreds of thousands of checks or the whole budget. More knots resolve what a coarse
+grid leaves violated. The
 continuation rung solves the problem relaxed first (a softened margin, wider limits) and the real one from there.
 The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
 shot finds in time.
@@ -72,6 +75,7 @@ MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
 MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
+OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.planner.ompl_seed.OMPL_PLANNERS)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take; a certified plan in hand ends the climb below it
 
@@ -112,7 +116,8 @@ class Rung:
             if self.seed is not None:
                 guess_options["seed"] = self.seed
             if self.guess == "ompl":
-                guess_options.update(max_checks=OMPL_CHECKS, planning_time=left, resolution=OMPL_RESOLUTION)
+                guess_options.update(planner_name=OMPL_PLANNER, max_checks=OMPL_CHECKS, planning_time=left,
+                                     resolution=OMPL_RESOLUTION)
             changes.update(guess=self.guess, guess_options=guess_options)
         if self.segments is None or options.pseudospectral():
             if self.knots is not None:

@@ -8,10 +8,15 @@ step is one function below, `ompl_seed` runs them in turn:
    spheres against each other, the obstacles and the workspace box), asked in C++ (`geometry.coal_check`):
    a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
    The joint limits are the state-space bounds.
-2. `ompl_path`: RRTConnect (or RRT*, BIT*, PRM) in joint space. A straight segment is checked, batched, at
-   configurations at most `resolution` rad apart (Euclidean over the joints). An RRT extends at most `max_step`
-   rad at a time (MAX_STEP; OMPL's own default, a fifth of the joint box's diagonal, is several radians on a
-   6- or 7-joint arm, and such long extensions into a cage or a shelf mostly fail). OMPL's PathSimplifier then
+2. `ompl_path`: RRTConnect (or RRT*, BIT*, PRM, LBKPIECE1, or RRTConnect then LBKPIECE1) in joint space. A
+   straight segment is checked, batched, at configurations at most `resolution` rad apart (Euclidean over the
+   joints). An RRT extends at most `max_step` rad at a time (MAX_STEP; OMPL's own default, a fifth of the joint
+   box's diagonal, is several radians on a 6- or 7-joint arm, and such long extensions into a cage or a shelf
+   mostly fail). "rrtconnect-lbkpiece" keeps RRTConnect's paths, the shortest of these before simplification,
+   where it finds one within STAGE_CHECKS configurations checked, and otherwise goes on with LBKPIECE1. That
+   one is lazy: it grows its trees without checking and checks only the edges of a candidate path, so in narrow
+   passages (a shelf, a cage), where most of RRTConnect's extensions collide, it needs far fewer checks.
+   OMPL's PathSimplifier then
    shortens the path until it stops improving. The last FOUND_PATHS paths found are kept: a search of the same
    problem object with the same options, budgeted in checks, returns its path again without searching (the
    simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
@@ -67,7 +72,11 @@ from ocpkit.problem import Problem
 from ocpkit.result import PathStats, Timing
 from ocpkit.robots import Robot, rigid_torque
 
-OMPL_PLANNERS = {"rrtconnect": "RRTConnect", "rrtstar": "RRTstar", "bitstar": "BITstar", "prm": "PRM"}
+OMPL_PLANNERS = {"rrtconnect": ("RRTConnect",), "rrtstar": ("RRTstar",), "bitstar": ("BITstar",), "prm": ("PRM",),
+                 "lbkpiece": ("LBKPIECE1",), "rrtconnect-lbkpiece": ("RRTConnect", "LBKPIECE1")}
+"""OMPL's planners by name. A name with two runs the first until it has checked STAGE_CHECKS configurations
+without a path, then the second with what is left of the budget (`ompl_path`)."""
+STAGE_CHECKS = 50_000
 REPAIR_ROUNDS = 8
 FRICTION_PASSES = 2
 TORQUE_RATE_WINDOW = 1e-3  # s
@@ -268,10 +277,17 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
         si = _space_information(problem, free, resolution)
         setup = og.SimpleSetup(si)
         setup.setStartAndGoalStates(_state(si, problem.start), _state(si, problem.goal))
-        setup.setPlanner(_planner(si, planner_name, max_step))
         start = time.perf_counter()
-        stop = _termination(ob, free, planning_time, max_checks)
-        setup.solve(stop)
+        stages = OMPL_PLANNERS[planner_name]
+        for stage, name in enumerate(stages):
+            budget = max_checks
+            if stage < len(stages) - 1:
+                budget = min(free.checks + STAGE_CHECKS, np.inf if max_checks is None else max_checks)
+            setup.clear()  # a planner before this one found no path: start afresh
+            setup.setPlanner(_planner(si, name, max_step))
+            setup.solve(_termination(ob, free, max(planning_time - (time.perf_counter() - start), 0.0), budget))
+            if setup.haveExactSolutionPath():
+                break
         path_time = time.perf_counter() - start
         if not setup.haveExactSolutionPath():
             return OmplPath(None, path_time, 0.0)
@@ -281,12 +297,12 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
         return OmplPath(waypoints, path_time, time.perf_counter() - start - path_time)
 
 
-def _planner(si: Any, planner_name: str, max_step: float | None) -> Any:
-    """The named OMPL planner on `si`; RRTConnect and RRT* extend at most `max_step` rad at a time (None: OMPL's
-    default step)."""
+def _planner(si: Any, name: str, max_step: float | None) -> Any:
+    """OMPL's planner class `name` on `si`; RRTConnect, RRT* and LBKPIECE1 extend at most `max_step` rad at a time
+    (None: OMPL's default step)."""
     import ompl.geometric as og
 
-    planner = getattr(og, OMPL_PLANNERS[planner_name])(si)
+    planner = getattr(og, name)(si)
     if max_step is not None and hasattr(planner, "setRange"):
         planner.setRange(max_step)
     return planner

@@ -101,10 +101,11 @@ def test_a_budget_in_checks_stops_the_search_without_a_timer(case1):
 
 def test_rrts_extend_at_most_max_step_and_a_step_that_is_not_positive_is_named(case1):
     si = _space_information(case1, planning_space(case1, 0.01), 0.01)
-    assert _planner(si, "rrtconnect", 0.7).getRange() == 0.7
-    assert _planner(si, "rrtstar", MAX_STEP).getRange() == MAX_STEP
-    assert _planner(si, "rrtconnect", None).getRange() == 0.0  # OMPL's default, set when the planner is set up
-    assert not hasattr(_planner(si, "bitstar", 0.7), "getRange")  # BIT* has no step: made as it is
+    assert _planner(si, "RRTConnect", 0.7).getRange() == 0.7
+    assert _planner(si, "RRTstar", MAX_STEP).getRange() == MAX_STEP
+    assert _planner(si, "LBKPIECE1", 0.7).getRange() == 0.7
+    assert _planner(si, "RRTConnect", None).getRange() == 0.0  # OMPL's default, set when the planner is set up
+    assert not hasattr(_planner(si, "BITstar", 0.7), "getRange")  # BIT* has no step: made as it is
     for step in (0.0, -1.0, np.inf, np.nan):
         with pytest.raises(OptionError, match="max_step"):
             plan_ompl_toppra(case1, max_step=step)

@@ -21,8 +21,9 @@ from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
-from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_RESOLUTION,
-                                   RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
+from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_PLANNER,
+                                   OMPL_RESOLUTION, RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered,
+                                   rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow
@@ -164,8 +165,9 @@ def test_a_rung_overrides_only_what_it_names():
                                   solver_options={"tol": 1e-7})
     changed = Rung("x", guess="ompl", seed=3, knots=16, segments=2, max_iterations=300).apply(options, 9.0)
     assert changed == dataclasses.replace(
-        options, guess="ompl", guess_options={"fallback": False, "seed": 3, "max_checks": OMPL_CHECKS,
-                                              "planning_time": 9.0, "resolution": OMPL_RESOLUTION}, knots=16,
+        options, guess="ompl", guess_options={"fallback": False, "seed": 3, "planner_name": OMPL_PLANNER,
+                                              "max_checks": OMPL_CHECKS, "planning_time": 9.0,
+                                              "resolution": OMPL_RESOLUTION}, knots=16,
         transcription_options={"staged": False, "segments": 2}, solver_options={"tol": 1e-7, "max_iterations": 300},
         iteration_budget=300)
     assert options.knots == 12 and options.solver_options == {"tol": 1e-7}
@@ -180,17 +182,20 @@ def test_a_rung_overrides_only_what_it_names():
 @pytest.mark.parametrize("rung, changes", [
     (DEFAULT_LADDER[0], {"solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[1], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
-                         "guess_options": {"fallback": False, "seed": 0, "max_checks": OMPL_CHECKS,
+                         "guess_options": {"fallback": False, "seed": 0, "planner_name": OMPL_PLANNER,
+                                           "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[3], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
-                         "guess_options": {"fallback": False, "seed": 1, "max_checks": OMPL_CHECKS,
+                         "guess_options": {"fallback": False, "seed": 1, "planner_name": OMPL_PLANNER,
+                                           "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[4], {"guess": "ompl", "knots": 16,
-                         "guess_options": {"fallback": False, "seed": 2, "max_checks": OMPL_CHECKS,
+                         "guess_options": {"fallback": False, "seed": 2, "planner_name": OMPL_PLANNER,
+                                           "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),

@@ -160,3 +160,21 @@ def test_keeps_answers_what_the_clearances_answer_at_another_margin_and_counts_i
     assert free.checks == before + len(q)
     assert 0 < kept.sum() < len(q)  # both answers occur
     np.testing.assert_array_equal(kept, reference)
+
+
+def test_rrtconnect_then_lbkpiece_keeps_rrtconnects_path_or_finds_one_lazily_after_its_stage(case1, monkeypatch):
+    def search(name: str) -> tuple[ompl_seed_module.OmplPath, ompl_seed_module.FreeSpace]:
+        problem = dataclasses.replace(case1)  # another object each time: searched, not reused
+        free = ompl_seed_module.planning_space(problem, 0.01)
+        return ompl_seed_module.ompl_path(problem, free, name, 5.0, 6, 0.02, max_checks=10**6), free
+
+    alone, _ = search("rrtconnect")
+    staged, _ = search("rrtconnect-lbkpiece")
+    np.testing.assert_array_equal(staged.waypoints, alone.waypoints)  # found within its stage: RRTConnect's path
+    monkeypatch.setattr(ompl_seed_module, "STAGE_CHECKS", 1)  # RRTConnect stops at once, LBKPIECE1 goes on
+    lazy, free = search("rrtconnect-lbkpiece")
+    assert lazy.waypoints is not None and free.checks > 1
+    np.testing.assert_array_equal(lazy.waypoints[[0, -1]], [case1.start, case1.goal])
+    checker = ompl_seed_module.planning_space(case1, 0.01)
+    assert all(checker.segment_free(a, b, 0.02) for a, b in zip(lazy.waypoints[:-1], lazy.waypoints[1:]))
+    np.testing.assert_array_equal(search("rrtconnect-lbkpiece")[0].waypoints, lazy.waypoints)  # seeded: repeats
