@@ -159,8 +159,8 @@ class _Near:
 
     def obstacles(self, within: float) -> np.ndarray:
         """The smallest obstacle clearance per configuration (K,), exact where at most `within` (m)."""
-        scene, groups, r = self.scene, self.groups, self.robot.sphere_radius
-        radius = groups.radius[None, :, None]
+        scene = self.scene
+        radius = self.groups.radius[None, :, None]
         kinds = []
         if len(scene.obstacle_radii):
             offsets = self.bounds[:, :, None] - scene.obstacle_centers[None, None]
@@ -175,14 +175,19 @@ class _Near:
                           lambda p, o: cylinder_distance_each(p, scene.cylinders, o)))
         smallest = np.full(len(self.centers), np.inf)
         for bound, distance_each in kinds:  # bound (K, G, O): a group's bounding sphere from each obstacle
-            def exact(k: np.ndarray, flat: np.ndarray, distance_each=distance_each, count=bound.shape[2]):
-                g, o = np.divmod(flat, count)
-                members = groups.members[g]
-                d = distance_each(self.centers[k[:, None], members], o) - r[members]
-                return np.where(groups.member_mask[g], d, np.inf).min(axis=1)
-
+            exact = functools.partial(self._obstacle, distance_each, bound.shape[2])
             smallest = np.minimum(smallest, _refined(bound.reshape(len(bound), -1), within, exact))
         return smallest
+
+    def _obstacle(self, distance_each: Callable[[np.ndarray, np.ndarray], np.ndarray], count: int, k: np.ndarray,
+                  flat: np.ndarray) -> np.ndarray:
+        """The smallest clearance of the spheres of group g from obstacle o (one kind of `count` obstacles) at
+        configuration k, for index arrays k and flat = g · count + o; `distance_each(points (n, w, 3), o (n,))`
+        gives the obstacles' signed distances (n, w)."""
+        g, o = np.divmod(flat, count)
+        members = self.groups.members[g]
+        d = distance_each(self.centers[k[:, None], members], o) - self.robot.sphere_radius[members]
+        return np.where(self.groups.member_mask[g], d, np.inf).min(axis=1)
 
 
 def _refined(bound: np.ndarray, within: float, exact: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> np.ndarray:

@@ -8,11 +8,12 @@ iteration cap of an earlier one is skipped (listed in `stats.skipped`) unless th
 share of the time: it would repeat the same solve. An empty ladder plans once with the call's options (the
 paper's single shot).
 
-Why these rungs: the straight line verifies most problems within a few hundred IPOPT iterations, and
-one that has not converged by then usually ends infeasible or at the iteration limit after many seconds, so the
-first rung is capped (MAX_ITERATIONS_CAPPED, per solve and for the rung's refinement rounds together): that cap is
-how the ladder leaves a local infeasibility, a restoration phase, a t_f pinned at its upper bound, or a motion that
-keeps tunnelling through a thin obstacle between check points round after round (MBM's cage) early. The OMPL +
+Why these rungs: the straight line verifies most problems within a hundred IPOPT iterations, and one that has not
+converged by then mostly ends infeasible or at the iteration limit after many seconds, so the first rung is capped
+(FIRST_ITERATIONS, per solve and for the rung's refinement rounds together): that cap is how the ladder leaves a
+local infeasibility, a restoration phase, a t_f pinned at its upper bound, or a motion that keeps tunnelling
+through a thin obstacle between check points round after round (MBM's cage) early. The other capped rungs, whose
+starts are better, get MAX_ITERATIONS_CAPPED. The OMPL +
 TOPP-RA motion (collision-free by construction) is the better start in clutter, and another seed gives another
 homotopy class when the first one is poor. The first two OMPL rungs solve on three pseudospectral segments of 6
 intervals (19 points instead of 12 knots' 13): piecewise polynomials follow a path with corners, where one
@@ -72,6 +73,7 @@ if TYPE_CHECKING:
     from ocpkit.planner.options import SimultaneousOptions
 
 MAX_ITERATIONS_CAPPED = 300  # IPOPT iterations per solve of a capped rung
+FIRST_ITERATIONS = 100  # IPOPT iterations per solve of the first rung, from the call's guess
 MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
@@ -146,7 +148,7 @@ def finer_grid(options: SimultaneousOptions) -> SimultaneousOptions:
 
 
 DEFAULT_LADDER: tuple[Rung, ...] = (
-    Rung("first", max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("first", max_iterations=FIRST_ITERATIONS),
     Rung("ompl-0-segments-3", guess="ompl", seed=0, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("ompl-0-topp3", guess="ompl", seed=0, safety_net=True),
     Rung("ompl-1-segments-3", guess="ompl", seed=1, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),

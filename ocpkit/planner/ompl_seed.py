@@ -16,10 +16,10 @@ step is one function below, `ompl_seed` runs them in turn:
    where it finds one within STAGE_CHECKS configurations checked, and otherwise goes on with LBKPIECE1. That
    one is lazy: it grows its trees without checking and checks only the edges of a candidate path, so in narrow
    passages (a shelf, a cage), where most of RRTConnect's extensions collide, it needs far fewer checks.
-   OMPL's PathSimplifier then
-   shortens the path until it stops improving. The last FOUND_PATHS paths found are kept: a search of the same
-   problem object with the same options, budgeted in checks, returns its path again without searching (the
-   simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
+   OMPL's PathSimplifier then shortens the path until it stops improving. The last FOUND_PATHS paths found are
+   kept: a search of the same problem object with the same options, budgeted in checks, returns its path again
+   without searching (the simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3:
+   ocpkit.planner.ladder).
 3. `smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
    tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
    obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
@@ -244,8 +244,9 @@ def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_tim
     again (no time; `free` counts the checks it took), if it is among the last FOUND_PATHS found.
 
     The time budget is OMPL's own timer. A check budget is a Python condition, safe only for planners that plan in
-    the calling thread (RRTConnect, RRT*, BIT*): PRM checks for a solution in a second thread, which would deadlock
-    waiting for the interpreter lock that the planning thread holds."""
+    the calling thread (RRTConnect, RRT*, BIT*, LBKPIECE1): PRM checks for a solution in a second thread, which
+    would deadlock waiting for the interpreter lock that the planning thread holds. A planner of two stages
+    (OMPL_PLANNERS) always budgets its first in checks."""
     if max_step is not None and not (np.isfinite(max_step) and max_step > 0):
         raise OptionError(f"max_step must be a finite number of radians > 0, got {max_step}")
     if max_checks is not None and planner_name == "prm":
@@ -446,8 +447,8 @@ class SeedOptions:
     TOPP-RA's path points. `margin` (m): clearance kept while planning, lowered to half the start's or goal's
     clearance if that is smaller (`planning_space`). `max_checks`: OMPL stops after checking this many
     configurations too (a budget that repeats on any machine; planning_time may then be inf; only for the
-    planners that plan in the calling thread, not PRM). `max_step` (rad): the longest extension of RRTConnect
-    and RRT* (OMPL's `range`; BIT* and PRM have none); None: OMPL's. `deadline` (a time.perf_counter() value):
+    planners that plan in the calling thread, not PRM). `max_step` (rad): the longest extension of RRTConnect,
+    RRT* and LBKPIECE1 (OMPL's `range`; BIT* and PRM have none); None: OMPL's. `deadline` (a time.perf_counter() value):
     the search also ends then, whatever `planning_time` is left: a planner's budget, which counts the validity
     checker's construction (a second or more on a robot with thousands of sphere pairs) too."""
 

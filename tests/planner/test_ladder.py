@@ -180,7 +180,7 @@ def test_a_rung_overrides_only_what_it_names():
 
 
 @pytest.mark.parametrize("rung, changes", [
-    (DEFAULT_LADDER[0], {"solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+    (DEFAULT_LADDER[0], {"solver_options": {"max_iterations": 100}, "iteration_budget": 100}),
     (DEFAULT_LADDER[1], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
                          "guess_options": {"fallback": False, "seed": 0, "planner_name": OMPL_PLANNER,
                                            "max_checks": OMPL_CHECKS,
