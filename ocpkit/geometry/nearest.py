@@ -10,7 +10,7 @@ elsewhere the value is a lower bound above `within`. `within` starts at WITHIN a
 smallest value over all the configurations is exact. So that minimum, every contact and every clearance up to
 `within` are what `clearances` gives (tests/geometry/test_nearest.py); a dense verification of a long motion of a
 robot with thousands of sphere pairs computes a small part of them. The workspace clearances are cheap and
-computed for every sphere.
+computed for every sphere. A small robot among few obstacles has all its clearances computed (FULL_TERMS).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ocpkit.geometry.clearances import points_on_joints, sphere_centers_batch
+from ocpkit.geometry.clearances import clearances, points_on_joints, sphere_centers_batch
 from ocpkit.geometry.distance import box_distance, box_distance_each, cylinder_distance, cylinder_distance_each
 from ocpkit.geometry.scene import Scene
 from ocpkit.robots import Robot
@@ -29,6 +29,7 @@ from ocpkit.robots import Robot
 GROUP_SIZE = 6  # spheres in a group at most
 WITHIN = 0.02  # m: the first threshold below which the smallest clearances are exact
 SLICE = 20_000  # candidate groups computed at once (bounds the memory of a long motion)
+FULL_TERMS = 100  # pair clearances per configuration up to which computing them all is faster
 
 
 @dataclass(frozen=True)
@@ -105,10 +106,17 @@ def _padded(rows: list) -> tuple[np.ndarray, np.ndarray]:
 
 
 def smallest_clearances(robot: Robot, scene: Scene, qs: np.ndarray) -> Nearest:
-    """The smallest clearance of each kind at each configuration of qs (K, n), exact as the module docstring says."""
-    groups = sphere_groups(robot)
+    """The smallest clearance of each kind at each configuration of qs (K, n), exact as the module docstring says;
+    exact everywhere for a robot and scene with at most FULL_TERMS pair clearances a configuration (a small robot
+    among few obstacles), where computing them all (`clearances`) is the faster way."""
     qs = np.atleast_2d(np.asarray(qs, dtype=float))
     centers = sphere_centers_batch(robot, qs)  # (K, M, 3)
+    obstacles = len(scene.obstacle_radii) + len(scene.boxes) + len(scene.cylinders)
+    if len(robot.self_collision) + len(robot.sphere_radius) * obstacles <= FULL_TERMS:
+        full = clearances(robot, scene, centers)
+        return Nearest(*(values.reshape(len(qs), -1).min(axis=1, initial=np.inf)
+                         for values in (full.self_pairs, full.obstacles, full.workspace)))
+    groups = sphere_groups(robot)
     bounds = points_on_joints(robot, qs, groups.joint, groups.offset)  # (K, G, 3)
     near = _Near(robot, scene, groups, centers, bounds)
     r = robot.sphere_radius

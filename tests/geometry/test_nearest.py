@@ -9,7 +9,8 @@ from helpers import REPO
 import ocpkit
 from ocpkit.bench.random import random_problems
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
-from ocpkit.geometry.nearest import WITHIN, smallest_clearances, sphere_groups
+import ocpkit.geometry.nearest
+from ocpkit.geometry.nearest import FULL_TERMS, WITHIN, smallest_clearances, sphere_groups
 
 PROBLEMS = {"mbm box (boxes, a cylinder)": REPO / "scenarios/mbm/panda/box/0001.yaml",
             "shapes (spheres, boxes, cylinders)": REPO / "scenarios/shapes/boxes.yaml"}
@@ -34,7 +35,8 @@ def wandering(problem: ocpkit.Problem, count: int) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name,problem", problems(), ids=lambda v: v if isinstance(v, str) else "")
-def test_every_clearance_up_to_the_threshold_is_exact_and_the_rest_bounded_below(name, problem):
+def test_every_clearance_up_to_the_threshold_is_exact_and_the_rest_bounded_below(name, problem, monkeypatch):
+    monkeypatch.setattr(ocpkit.geometry.nearest, "FULL_TERMS", 0)  # the groups' way, however small the robot
     robot = problem.robot
     q = wandering(problem, 1200)
     full = clearances(robot, problem.scene, sphere_centers_batch(robot, q))
@@ -69,3 +71,14 @@ def test_the_groups_hold_every_sphere_once_inside_their_bounds():
     pairs = {(a, b) for first, second, mask in zip(groups.first, groups.second, groups.pair_mask)
              for a, b in zip(first[mask], second[mask])}
     assert pairs == set(map(tuple, robot.self_collision.tolist()))
+
+
+def test_a_small_robot_among_few_obstacles_gets_every_clearance_exactly():
+    problem = list(random_problems(500, 1))[0]
+    robot, scene = problem.robot, problem.scene
+    assert len(robot.self_collision) + len(robot.sphere_radius) * len(scene.obstacle_radii) <= FULL_TERMS
+    q = wandering(problem, 300)
+    full = clearances(robot, scene, sphere_centers_batch(robot, q))
+    got = smallest_clearances(robot, scene, q)
+    for kind in ("self_pairs", "obstacles", "workspace"):
+        np.testing.assert_array_equal(getattr(got, kind), per_configuration(getattr(full, kind)))
