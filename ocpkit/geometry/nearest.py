@@ -34,8 +34,9 @@ FULL_TERMS = 100  # pair clearances per configuration up to which computing them
 
 @dataclass(frozen=True)
 class Nearest:
-    """The smallest clearance (m) per configuration (K,) of each kind: self pairs, obstacles, workspace faces;
-    inf where the kind has nothing to check."""
+    """The smallest clearance (m) per configuration (K,) of each kind: self pairs, obstacles, workspace faces; inf
+    where the kind has nothing to check. Exact as `smallest_clearances` says: every value up to its kind's last
+    threshold and each kind's minimum; a larger value is a lower bound of the configuration's smallest clearance."""
 
     self_pairs: np.ndarray
     obstacles: np.ndarray

@@ -12,8 +12,8 @@ Why these rungs: the straight line verifies most problems within a hundred IPOPT
 converged by then mostly ends infeasible or at the iteration limit after many seconds, so the first rung is capped
 (FIRST_ITERATIONS, per solve and for the rung's refinement rounds together): that cap is how the ladder leaves a
 local infeasibility, a restoration phase, a t_f pinned at its upper bound, or a motion that keeps tunnelling
-through a thin obstacle between check points round after round (MBM's cage) early. The other capped rungs, whose
-starts are better, get MAX_ITERATIONS_CAPPED. The OMPL +
+through a thin obstacle between check points round after round (MBM's cage) early. The other capped rungs keep
+MAX_ITERATIONS_CAPPED. The OMPL +
 TOPP-RA motion (collision-free by construction) is the better start in clutter, and another seed gives another
 homotopy class when the first one is poor. The first two OMPL rungs solve on three pseudospectral segments of 6
 intervals (19 points instead of 12 knots' 13): piecewise polynomials follow a path with corners, where one
