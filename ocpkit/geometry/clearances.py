@@ -130,13 +130,18 @@ def clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> Clearances:
     shapes = ((box_distance, scene.boxes), (cylinder_distance, scene.cylinders))
     distances += [distance(centers, group) for distance, group in shapes if len(group)]  # skipped when empty: the
     obstacles = np.concatenate(distances, axis=-1) - r[:, None]  # OMPL validity checker calls this thousands of times
+    return Clearances(self_pairs, obstacles, workspace_clearances(robot, scene, centers))
+
+
+def workspace_clearances(robot: Robot, scene: Scene, centers: np.ndarray) -> np.ndarray:
+    """Clearances (K, M, 6) of sphere centres (K, M, 3) from the workspace's faces, lower x, y, z then upper; (K, M, 0)
+    without a workspace."""
+    r = robot.sphere_radius
     if scene.workspace is None:
-        workspace = np.zeros((len(centers), len(r), 0))
-    else:
-        below = centers - scene.workspace.lower - r[:, None]
-        above = scene.workspace.upper - centers - r[:, None]
-        workspace = np.concatenate([below, above], axis=-1)
-    return Clearances(self_pairs, obstacles, workspace)
+        return np.zeros((len(centers), len(r), 0))
+    below = centers - scene.workspace.lower - r[:, None]
+    above = scene.workspace.upper - centers - r[:, None]
+    return np.concatenate([below, above], axis=-1)
 
 
 def collision_report(robot: Robot, scene: Scene, q: np.ndarray) -> list[str]:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ocpkit.geometry.clearances import clearances, points_on_joints, sphere_centers_batch
+from ocpkit.geometry.clearances import clearances, points_on_joints, sphere_centers_batch, workspace_clearances
 from ocpkit.geometry.distance import box_distance, box_distance_each, cylinder_distance, cylinder_distance_each
 from ocpkit.geometry.scene import Scene
 from ocpkit.robots import Robot
@@ -115,19 +115,17 @@ def smallest_clearances(robot: Robot, scene: Scene, qs: np.ndarray) -> Nearest:
     obstacles = len(scene.obstacle_radii) + len(scene.boxes) + len(scene.cylinders)
     if len(robot.self_collision) + len(robot.sphere_radius) * obstacles <= FULL_TERMS:
         full = clearances(robot, scene, centers)
-        return Nearest(*(values.reshape(len(qs), -1).min(axis=1, initial=np.inf)
-                         for values in (full.self_pairs, full.obstacles, full.workspace)))
+        return Nearest(*map(_per_configuration, (full.self_pairs, full.obstacles, full.workspace)))
     groups = sphere_groups(robot)
     bounds = points_on_joints(robot, qs, groups.joint, groups.offset)  # (K, G, 3)
     near = _Near(robot, scene, groups, centers, bounds)
-    r = robot.sphere_radius
-    if scene.workspace is None:
-        workspace = np.full(len(qs), np.inf)
-    else:
-        below = centers - scene.workspace.lower - r[:, None]
-        above = scene.workspace.upper - centers - r[:, None]
-        workspace = np.minimum(below.min(axis=(1, 2)), above.min(axis=(1, 2)))
-    return Nearest(_doubled(near.self_pairs), _doubled(near.obstacles), workspace)
+    return Nearest(_doubled(near.self_pairs), _doubled(near.obstacles),
+                   _per_configuration(workspace_clearances(robot, scene, centers)))
+
+
+def _per_configuration(values: np.ndarray) -> np.ndarray:
+    """The smallest of values (K, ...) per configuration (K,), inf where there are none."""
+    return values.reshape(len(values), -1).min(axis=1, initial=np.inf)
 
 
 def _doubled(smallest: Callable[[float], np.ndarray]) -> np.ndarray:

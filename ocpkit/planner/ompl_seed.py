@@ -284,7 +284,8 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
             budget = max_checks
             if stage < len(stages) - 1:
                 budget = min(free.checks + STAGE_CHECKS, np.inf if max_checks is None else max_checks)
-            setup.clear()  # a planner before this one found no path: start afresh
+            if stage:
+                setup.clear()  # the planner before this one found no path: start afresh
             setup.setPlanner(_planner(si, name, max_step))
             setup.solve(_termination(ob, free, max(planning_time - (time.perf_counter() - start), 0.0), budget))
             if setup.haveExactSolutionPath():
