@@ -8,18 +8,19 @@ step is one function below, `ompl_seed` runs them in turn:
    spheres against each other, the obstacles and the workspace box), asked in C++ (`geometry.coal_check`):
    a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
    The joint limits are the state-space bounds.
-2. `ompl_path`: RRTConnect (or RRT*, BIT*, PRM, LBKPIECE1, or RRTConnect then LBKPIECE1) in joint space. A
-   straight segment is checked, batched, at configurations at most `resolution` rad apart (Euclidean over the
-   joints). An RRT extends at most `max_step` rad at a time (MAX_STEP; OMPL's own default, a fifth of the joint
-   box's diagonal, is several radians on a 6- or 7-joint arm, and such long extensions into a cage or a shelf
-   mostly fail). "rrtconnect-lbkpiece" keeps RRTConnect's paths, the shortest of these before simplification,
-   where it finds one within STAGE_CHECKS configurations checked, and otherwise goes on with LBKPIECE1. That
-   one is lazy: it grows its trees without checking and checks only the edges of a candidate path, so in narrow
-   passages (a shelf, a cage), where most of RRTConnect's extensions collide, it needs far fewer checks.
-   OMPL's PathSimplifier then shortens the path until it stops improving. The last FOUND_PATHS paths found are
-   kept: a search of the same problem object with the same options, budgeted in checks, returns its path again
-   without searching (the simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3:
-   ocpkit.planner.ladder).
+2. `ompl_path`: RRTConnect (or RRT*, BIT*, PRM, LBKPIECE1, or RRTConnect then LBKPIECE1) in joint space, its
+   coordinates scaled by each joint's velocity limit (`JointSpace`, `time_scale`): OMPL's distances, and so its
+   nearest neighbours and shortcuts, measure the time a move takes, not its radians. A straight segment is checked,
+   batched, at configurations at most `resolution` rad apart (Euclidean over the joints). An RRT extends at most
+   `max_step` (MAX_STEP) at a time, in OMPL's coordinates: rad of the fastest joint. OMPL's own default, a fifth of
+   the box's diagonal, is several radians on a 6- or 7-joint arm, and such long extensions into a cage or a shelf
+   mostly fail. "rrtconnect-lbkpiece" keeps RRTConnect's paths, the shortest of these before simplification, where
+   it finds one within STAGE_CHECKS configurations checked, and otherwise goes on with LBKPIECE1. That one is lazy:
+   it grows its trees without checking and checks only the edges of a candidate path, so in narrow passages (a
+   shelf, a cage), where most of RRTConnect's extensions collide, it needs far fewer checks. OMPL's PathSimplifier
+   then shortens the path until it stops improving. The last FOUND_PATHS paths found are kept: a search of the same
+   problem object with the same options, budgeted in checks, returns its path again without searching (the
+   simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
 3. `smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
    tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
    obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
@@ -174,39 +175,50 @@ def _seed_ompl(util: Any, seed: int) -> None:
         util.RNG.setSeed(seed + 1)
 
 
-def _space_information(problem: Problem, free: FreeSpace, resolution: float) -> Any:
-    """OMPL's joint space: the joint limits as bounds, `free` as the state validity checker, and straight
-    segments checked by `free.segment_free` at `resolution` rad."""
-    import ompl.base as ob
+class JointSpace:
+    """OMPL's space information over the joints, in time-scaled coordinates: OMPL's coordinate i is q_i × `scale`_i
+    (`time_scale`). The joint limits are its bounds, `free` its state validity checker, and a straight segment is
+    checked by `free.segment_free` at configurations at most `resolution` rad apart (in joint space)."""
 
-    robot, n = problem.robot, problem.robot.n
-    space = ob.RealVectorStateSpace(n)
-    bounds = ob.RealVectorBounds(n)
-    bounds.low, bounds.high = robot.q_lower.tolist(), robot.q_upper.tolist()
-    space.setBounds(bounds)
-    si = ob.SpaceInformation(space)
+    def __init__(self, problem: Problem, free: FreeSpace, resolution: float) -> None:
+        import ompl.base as ob
 
-    class SegmentValidator(ob.MotionValidator):
-        def checkMotion(self, a: Any, b: Any) -> bool:  # OMPL's name
-            return free.segment_free(_vector(a, n), _vector(b, n), resolution)
+        robot, self.scale = problem.robot, time_scale(problem.robot)
+        space = ob.RealVectorStateSpace(robot.n)
+        bounds = ob.RealVectorBounds(robot.n)
+        bounds.low, bounds.high = (robot.q_lower * self.scale).tolist(), (robot.q_upper * self.scale).tolist()
+        space.setBounds(bounds)
+        self.si = ob.SpaceInformation(space)
+        self.lower, self.upper = robot.q_lower, robot.q_upper
+        q = self.q
 
-    si.setStateValidityChecker(lambda state: bool(free.free(_vector(state, n)[None])[0]))
-    si.setMotionValidator(SegmentValidator(si))
-    si.setup()
-    return si
+        class SegmentValidator(ob.MotionValidator):
+            def checkMotion(self, a: Any, b: Any) -> bool:  # OMPL's name
+                return free.segment_free(q(a), q(b), resolution)
+
+        self.si.setStateValidityChecker(lambda state: bool(free.free(q(state)[None])[0]))
+        self.si.setMotionValidator(SegmentValidator(self.si))
+        self.si.setup()
+
+    def q(self, state: Any) -> np.ndarray:
+        """The configuration (n,) rad of an OMPL state."""
+        return np.array(state[0:len(self.scale)]) / self.scale
+
+    def state(self, q: np.ndarray) -> Any:
+        """A new OMPL state holding q (n,), clipped into the joint limits (scenario files allow 1e-9 rad of
+        round-off)."""
+        state = self.si.allocState()
+        state[0:len(q)] = (np.clip(q, self.lower, self.upper) * self.scale).tolist()
+        return state
 
 
-def _vector(state: Any, n: int) -> np.ndarray:
-    """An OMPL real-vector state as an array (n,)."""
-    return np.array(state[0:n])
-
-
-def _state(si: Any, q: np.ndarray) -> Any:
-    """A new OMPL state holding q (n,), clipped into the joint limits (scenario files allow 1e-9 rad of round-off)."""
-    bounds = si.getStateSpace().getBounds()
-    state = si.allocState()
-    state[0:len(q)] = np.clip(q, bounds.low, bounds.high).tolist()
-    return state
+def time_scale(robot: Robot) -> np.ndarray:
+    """Per-joint factor (n,) from radians (or metres) to OMPL's coordinates: the fastest joint's velocity limit over
+    each joint's. A distance in OMPL's space is then the time a move takes at full speed, in radians of the fastest
+    joint, so RRT's nearest neighbours, its steps and the simplifier's shortcuts weigh a slow joint by the time it
+    takes, not by its travel: on the Fetch, whose torso lifts at 0.1 m/s against 1.3–2.3 rad/s for the arm, a path
+    shortened in joint space kept the torso going up and down and took longer than the scenarios' 10 s."""
+    return robot.qd_max.max() / robot.qd_max
 
 
 def _termination(ob: Any, free: FreeSpace, planning_time: float, max_checks: int | None) -> Any:
@@ -275,9 +287,9 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
 
     with _ompl_log_level(ou, ou.LOG_ERROR):
         _seed_ompl(ou, seed)
-        si = _space_information(problem, free, resolution)
-        setup = og.SimpleSetup(si)
-        setup.setStartAndGoalStates(_state(si, problem.start), _state(si, problem.goal))
+        space = JointSpace(problem, free, resolution)
+        setup = og.SimpleSetup(space.si)
+        setup.setStartAndGoalStates(space.state(problem.start), space.state(problem.goal))
         start = time.perf_counter()
         stages = OMPL_PLANNERS[planner_name]
         for stage, name in enumerate(stages):
@@ -286,7 +298,7 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
                 budget = min(free.checks + STAGE_CHECKS, np.inf if max_checks is None else max_checks)
             if stage:
                 setup.clear()  # the planner before this one found no path: start afresh
-            setup.setPlanner(_planner(si, name, max_step))
+            setup.setPlanner(_planner(space.si, name, max_step))
             setup.solve(_termination(ob, free, max(planning_time - (time.perf_counter() - start), 0.0), budget))
             if setup.haveExactSolutionPath():
                 break
@@ -294,8 +306,9 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
         if not setup.haveExactSolutionPath():
             return OmplPath(None, path_time, 0.0)
         path = og.PathGeometric(setup.getSolutionPath())
-        og.PathSimplifier(si).simplifyMax(path)
-        waypoints = np.array([_vector(state, problem.robot.n) for state in path.getStates()])
+        og.PathSimplifier(space.si).simplifyMax(path)
+        waypoints = np.array([space.q(state) for state in path.getStates()])
+        waypoints[[0, -1]] = np.clip([problem.start, problem.goal], space.lower, space.upper)  # not rounded by scale
         return OmplPath(waypoints, path_time, time.perf_counter() - start - path_time)
 
 

@@ -15,7 +15,7 @@ import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
 from ocpkit.baselines.ompl_toppra import plan_ompl_toppra
 from ocpkit.errors import OptionError, RegistryError, ScenarioError
 from ocpkit.geometry.clearances import clearances, sphere_centers
-from ocpkit.planner.ompl_seed import MAX_STEP, FreeSpace, _planner, _space_information, _state, planning_space
+from ocpkit.planner.ompl_seed import MAX_STEP, FreeSpace, JointSpace, _planner, planning_space
 from ocpkit.tolerances import GEOMETRY_TOLERANCE
 
 
@@ -40,8 +40,8 @@ def verifier_says_free(problem, q):
 
 
 def test_ompl_validity_checker_agrees_with_the_verifier(case1, configurations):
-    si = _space_information(case1, FreeSpace(case1, 0.0), resolution=0.01)
-    ompl_free = np.array([si.isValid(_state(si, q)) for q in configurations])
+    space = JointSpace(case1, FreeSpace(case1, 0.0), resolution=0.01)
+    ompl_free = np.array([space.si.isValid(space.state(q)) for q in configurations])
     expected = verifier_says_free(case1, configurations)
     assert 50 < expected.sum() < len(configurations) - 50  # both verdicts are well represented
     np.testing.assert_array_equal(ompl_free, expected)
@@ -100,7 +100,7 @@ def test_a_budget_in_checks_stops_the_search_without_a_timer(case1):
 
 
 def test_rrts_extend_at_most_max_step_and_a_step_that_is_not_positive_is_named(case1):
-    si = _space_information(case1, planning_space(case1, 0.01), 0.01)
+    si = JointSpace(case1, planning_space(case1, 0.01), 0.01).si
     assert _planner(si, "RRTConnect", 0.7).getRange() == 0.7
     assert _planner(si, "RRTstar", MAX_STEP).getRange() == MAX_STEP
     assert _planner(si, "LBKPIECE1", 0.7).getRange() == 0.7
@@ -165,8 +165,8 @@ def test_ompl_avoids_boxes_and_cylinders():
     problem = ocpkit.load_scenario(REPO / "scenarios/shapes/boxes.yaml")
     rng = np.random.default_rng(5)
     configurations = rng.uniform(problem.robot.q_lower, problem.robot.q_upper, (300, problem.robot.n))
-    si = _space_information(problem, FreeSpace(problem, 0.0), resolution=0.01)
-    ompl_free = np.array([si.isValid(_state(si, q)) for q in configurations])
+    space = JointSpace(problem, FreeSpace(problem, 0.0), resolution=0.01)
+    ompl_free = np.array([space.si.isValid(space.state(q)) for q in configurations])
     obstacle_free = clearances(problem.robot, problem.scene, sphere_centers(problem.robot, configurations)
                                ).obstacles.min(axis=(1, 2)) >= 0
     assert (~obstacle_free).sum() >= 20  # the boxes and cylinders do reject configurations
