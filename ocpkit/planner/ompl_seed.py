@@ -8,19 +8,20 @@ step is one function below, `ompl_seed` runs them in turn:
    spheres against each other, the obstacles and the workspace box), asked in C++ (`geometry.coal_check`):
    a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
    The joint limits are the state-space bounds.
-2. `ompl_path`: RRTConnect (or RRT*, BIT*, PRM, LBKPIECE1, or RRTConnect then LBKPIECE1) in joint space, its
-   coordinates scaled by each joint's velocity limit (`JointSpace`, `time_scale`): OMPL's distances, and so its
-   nearest neighbours and shortcuts, measure the time a move takes, not its radians. A straight segment is checked,
-   batched, at configurations at most `resolution` rad apart (Euclidean over the joints). An RRT extends at most
-   `max_step` (MAX_STEP) at a time, in OMPL's coordinates: rad of the fastest joint. OMPL's own default, a fifth of
-   the box's diagonal, is several radians on a 6- or 7-joint arm, and such long extensions into a cage or a shelf
-   mostly fail. "rrtconnect-lbkpiece" keeps RRTConnect's paths, the shortest of these before simplification, where
-   it finds one within STAGE_CHECKS configurations checked, and otherwise goes on with LBKPIECE1. That one is lazy:
-   it grows its trees without checking and checks only the edges of a candidate path, so in narrow passages (a
-   shelf, a cage), where most of RRTConnect's extensions collide, it needs far fewer checks. OMPL's PathSimplifier
-   then shortens the path until it stops improving. The last FOUND_PATHS paths found are kept: a search of the same
-   problem object with the same options, budgeted in checks, returns its path again without searching (the
-   simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
+2. `ompl_path`: RRTConnect (or RRT*, BIT*, PRM, LBKPIECE1, or RRTConnect then LBKPIECE1) in joint space, its slow
+   joints' coordinates scaled by their velocity limits (`JointSpace`, `time_scale`): OMPL's distances, and so its
+   nearest neighbours and shortcuts, count a slow joint's move by the time it takes, not its radians. A straight
+   segment is checked, batched, at configurations at most `resolution` rad apart (Euclidean over the joints). An RRT
+   extends at most `max_step` (MAX_STEP) at a time, in OMPL's coordinates: rad of a typical joint. OMPL's own
+   default, a fifth of the box's diagonal, is several radians on a 6- or 7-joint arm, and such long extensions into
+   a cage or a shelf mostly fail. "rrtconnect-lbkpiece" keeps RRTConnect's paths, the shortest of these before
+   simplification, where it finds one within STAGE_CHECKS configurations checked, and otherwise goes on with
+   LBKPIECE1. That one is lazy: it grows its trees without checking and checks only the edges of a candidate path,
+   so in narrow passages (a shelf, a cage), where most of RRTConnect's extensions collide, it needs far fewer
+   checks. OMPL's PathSimplifier then shortens the path until it stops improving. The last FOUND_PATHS paths found
+   are kept: a search of the same problem object with the same options, budgeted in checks, returns its path again
+   without searching (the simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3:
+   ocpkit.planner.ladder).
 3. `smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
    tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
    obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
@@ -213,12 +214,14 @@ class JointSpace:
 
 
 def time_scale(robot: Robot) -> np.ndarray:
-    """Per-joint factor (n,) from radians (or metres) to OMPL's coordinates: the fastest joint's velocity limit over
-    each joint's. A distance in OMPL's space is then the time a move takes at full speed, in radians of the fastest
-    joint, so RRT's nearest neighbours, its steps and the simplifier's shortcuts weigh a slow joint by the time it
-    takes, not by its travel: on the Fetch, whose torso lifts at 0.1 m/s against 1.3–2.3 rad/s for the arm, a path
-    shortened in joint space kept the torso going up and down and took longer than the scenarios' 10 s."""
-    return robot.qd_max.max() / robot.qd_max
+    """Per-joint factor (n,) from radians (or metres) to OMPL's coordinates: a joint slower than the robot's median
+    velocity limit is scaled by the median over its own limit, the others by 1. A distance in OMPL's space then
+    counts a slow joint's move by the time it takes, in radians of a typical joint, so RRT's nearest neighbours,
+    its steps and the simplifier's shortcuts do not move it back and forth for nothing: on the Fetch, whose torso
+    lifts at 0.1 m/s against 1.3–2.3 rad/s for the arm, a path shortened in joint space kept the torso going up
+    and down and took longer than the scenarios' 10 s. A faster joint is not made cheaper: moving it still sweeps
+    the arm through the scene, and on the Panda (wrist 1.2 times as fast) that made the solves slower."""
+    return np.maximum(np.median(robot.qd_max) / robot.qd_max, 1.0)
 
 
 def _termination(ob: Any, free: FreeSpace, planning_time: float, max_checks: int | None) -> Any:

@@ -180,18 +180,24 @@ def test_rrtconnect_then_lbkpiece_keeps_rrtconnects_path_or_finds_one_lazily_aft
     np.testing.assert_array_equal(search("rrtconnect-lbkpiece")[0].waypoints, lazy.waypoints)  # seeded: repeats
 
 
-def test_ompls_distances_are_times_at_full_speed_and_its_paths_end_exactly_at_start_and_goal(case1):
+def test_ompl_counts_a_slow_joints_move_by_its_time_and_its_paths_end_exactly_at_start_and_goal(case1):
     robot = case1.robot
     space = ompl_seed_module.JointSpace(case1, ompl_seed_module.planning_space(case1, 0.01), 0.02)
-    fastest = robot.qd_max.max()
-    assert robot.qd_max.min() < fastest  # the paper's robot has slow and fast joints: the scale is not uniform
+    typical = np.median(robot.qd_max)
+    slow = robot.qd_max < typical
+    assert 0 < slow.sum() < robot.n  # the paper's robot has slow and fast joints
     q = 0.5 * (robot.q_lower + robot.q_upper)
     for joint in range(robot.n):
         moved = q.copy()
         moved[joint] += 0.3
-        seconds = 0.3 / robot.qd_max[joint]  # at the joint's full speed
-        assert space.si.distance(space.state(q), space.state(moved)) == pytest.approx(seconds * fastest, rel=1e-12)
+        expected = 0.3 * typical / robot.qd_max[joint] if slow[joint] else 0.3  # seconds × typical speed, or rad
+        assert space.si.distance(space.state(q), space.state(moved)) == pytest.approx(expected, rel=1e-12)
     np.testing.assert_allclose(space.q(space.state(q)), q, rtol=1e-15)
     found = ompl_seed_module.ompl_path(case1, ompl_seed_module.planning_space(case1, 0.01), "rrtconnect", 5.0, 7,
                                        0.02, max_checks=10**6)
     np.testing.assert_array_equal(found.waypoints[[0, -1]], [case1.start, case1.goal])
+
+
+def test_a_robot_without_slow_joints_plans_in_radians():
+    panda = ocpkit.load_scenario(REPO / "scenarios/mbm/panda/box/0001.yaml").robot
+    np.testing.assert_array_equal(ompl_seed_module.time_scale(panda), np.ones(panda.n))
