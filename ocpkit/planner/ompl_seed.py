@@ -217,10 +217,9 @@ def time_scale(robot: Robot) -> np.ndarray:
     """Per-joint factor (n,) from radians (or metres) to OMPL's coordinates: a joint slower than the robot's median
     velocity limit is scaled by the median over its own limit, the others by 1. A distance in OMPL's space then
     counts a slow joint's move by the time it takes, in radians of a typical joint, so RRT's nearest neighbours,
-    its steps and the simplifier's shortcuts do not move it back and forth for nothing: on the Fetch, whose torso
-    lifts at 0.1 m/s against 1.3–2.3 rad/s for the arm, a path shortened in joint space kept the torso going up
-    and down and took longer than the scenarios' 10 s. A faster joint is not made cheaper: moving it still sweeps
-    the arm through the scene, and on the Panda (wrist 1.2 times as fast) that made the solves slower."""
+    its steps and the simplifier's shortcuts do not move a slow joint (the Fetch's torso lift, 0.1 m/s against
+    1.3–2.3 rad/s for its arm) back and forth for nothing. A faster joint is not made cheaper: moving it still
+    sweeps the arm through the scene (docs/design-notes.md, 2026-12-03)."""
     return np.maximum(np.median(robot.qd_max) / robot.qd_max, 1.0)
 
 
