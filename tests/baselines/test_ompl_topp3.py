@@ -219,11 +219,11 @@ def test_every_paper_case_verifies_and_passes_the_outside_check(case, tmp_path):
 
 
 def test_a_path_that_leaves_the_joint_limits_is_repaired():
-    """Random problem 7 (seed 1): the natural quintic through its OMPL waypoints leaves a joint's position limit,
+    """Random problem 19 (seed 5): the natural quintic through its OMPL waypoints leaves a joint's position limit,
     which no timing can fix; the smoothing repairs it (a waypoint inserted) and the plan verifies."""
     from ocpkit.bench.random import random_problems
 
-    problem = next(p for p in random_problems(1, 30) if p.name == "random7")
+    problem = next(p for p in random_problems(5, 30) if p.name == "random19")
     plan = ocpkit.plan(problem, planner="ompl-topp3")
     assert plan.stats.path.repair_rounds >= 1 and plan.stats.figures()["repair_rounds"] >= 1
     assert plan.status == "verified", plan.verification.summary()
