@@ -76,6 +76,9 @@ def test_a_solver_that_cannot_take_the_nlp_says_so_at_set_up(name, options, exac
 
 VERIFIES = {"ipopt", "sqpmethod", "pyomo", "scp"}
 """Solvers that reliably verify case 2 at 8 knots; the others must end in a reported status."""
+VERIFY_TIME = 120.0
+"""s a solver of VERIFIES gets for its single shot: the test asks whether it converges, not how fast (sqpmethod's
+dense QPs take seconds an iteration, and a tight limit made the test depend on the machine)."""
 
 
 @pytest.mark.slow  # scp: tests/solvers/test_scp.py plans the same case at 8 knots and also compares t_f with ipopt's
@@ -83,7 +86,9 @@ VERIFIES = {"ipopt", "sqpmethod", "pyomo", "scp"}
 def test_solver_plans_a_paper_case(name):
     problem = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
     grid = {"transcription": "hermite-simpson"} if SOLVERS.get(name).needs_stages else {}  # staged by itself
-    plan = ocpkit.plan(problem, knots=8, solver=name, solver_options={"max_wall_time": 15.0}, **grid)
+    limit = VERIFY_TIME if name in VERIFIES else 15.0
+    plan = ocpkit.plan(problem, knots=8, solver=name, solver_options={"max_wall_time": limit}, max_wall_time=limit,
+                       fallbacks=(), **grid)  # the solver's own solve, not the ladder's rungs
     print(f"{name}: {plan.status} t_f={plan.trajectory.tf:.4f} iterations={plan.stats.iterations}")
     assert plan.status in {"verified", "violated", "iteration_limit", "time_limit", "failed", "infeasible"}
     if name in VERIFIES:
