@@ -67,7 +67,7 @@ class Recording(PreparedSolver):
     def __init__(self, pause: float) -> None:
         self.pause, self.limits = pause, []
 
-    def solve(self, guess, params, bounds, max_wall_time=None):
+    def solve(self, guess, params, bounds, max_wall_time=None, pace=None):
         self.limits.append(max_wall_time)
         time.sleep(self.pause)
         return SolverResult(np.clip(guess, *bounds), SolverStatus.CONVERGED, 1, self.pause, "ok")

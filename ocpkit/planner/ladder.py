@@ -50,6 +50,13 @@ no other rung verifies (anytime: the best certified plan found within the budget
 plan in hand the ladder climbs on only while a capped rung's share of the budget is left: a rung that could not
 have its share is not worth the wait for an answer already certified.
 
+An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as that many iterations, at the pace
+of its iterations so far, would not end within the rung's time. Where an iteration is slow (a large NLP: the
+Fetch's thousands of self-collision rows) and the path search has taken much of the rung's share, the solve would
+end at its time limit anyway, most often unconverged: it gives that time to the safety net, which times the same
+path, instead. A hundred iterations is where most solves that converge have (the first rung's cap); a solve
+whose iterations are fast enough never notices the pace.
+
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
 options on a finer grid (`finer_grid`: one more pseudospectral segment; half as many intervals again for a local
@@ -79,6 +86,7 @@ OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
 OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.planner.ompl_seed.OMPL_PLANNERS)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
+PACE_ITERATIONS = 100  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
 RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take; a certified plan in hand ends the climb below it
 
 
@@ -89,10 +97,12 @@ class Rung:
     without segments keeps the call's knots too), `max_iterations` per solve (None: the solver's; no
     refinement round starts once the rung's solves have used that many),
     `relaxed`: a continuation, solving the problem relaxed (ocpkit.planner.refinement.RELAXED) first to warm-start
-    the real one, and `refines`: a motion to re-solve on a finer grid than the rung's own (`finer`), its guess
-    instead of `guess`. An "ompl" rung's path search stops after OMPL_CHECKS configurations checked or when the
-    rung's time is up. A `safety_net` rung (guess "ompl") plans with ompl-topp3 instead, on the OMPL path of
-    its `seed` (module docstring); the simultaneous planner runs it, not `apply`."""
+    the real one, `refines`: a motion to re-solve on a finer grid than the rung's own (`finer`), its guess
+    instead of `guess`, and `pace`: the rung's first solve stops as soon as that many iterations at its pace
+    would not end within the rung's time (PreparedSolver.solve). An "ompl" rung's path search stops after
+    OMPL_CHECKS configurations checked or when the rung's time is up. A `safety_net` rung (guess "ompl") plans
+    with ompl-topp3 instead, on the OMPL path of its `seed` (module docstring); the simultaneous planner runs it,
+    not `apply`."""
 
     name: str
     guess: str | None = None
@@ -103,6 +113,7 @@ class Rung:
     relaxed: bool = False
     refines: Trajectory | None = field(default=None, compare=False, repr=False)
     safety_net: bool = False
+    pace: int | None = None
 
     def apply(self, options: SimultaneousOptions, left: float) -> SimultaneousOptions:
         """`options` with this rung's overrides. A rung's guess comes with its own options instead of the call's:
@@ -131,6 +142,8 @@ class Rung:
                            iteration_budget=self.max_iterations)
         if self.relaxed:
             changes["relaxed"] = True
+        if self.pace is not None:
+            changes["pace"] = self.pace
         changed = dataclasses.replace(options, **changes)
         if self.refines is not None:
             changed = dataclasses.replace(finer_grid(changed), refines=self.refines)
@@ -149,10 +162,13 @@ def finer_grid(options: SimultaneousOptions) -> SimultaneousOptions:
 
 DEFAULT_LADDER: tuple[Rung, ...] = (
     Rung("first", max_iterations=FIRST_ITERATIONS),
-    Rung("ompl-0-segments-3", guess="ompl", seed=0, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-0-segments-3", guess="ompl", seed=0, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED,
+         pace=PACE_ITERATIONS),
     Rung("ompl-0-topp3", guess="ompl", seed=0, safety_net=True),
-    Rung("ompl-1-segments-3", guess="ompl", seed=1, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED),
-    Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED),
+    Rung("ompl-1-segments-3", guess="ompl", seed=1, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED,
+         pace=PACE_ITERATIONS),
+    Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED,
+         pace=PACE_ITERATIONS),
     Rung("relaxed-first", relaxed=True, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("first-uncapped"),
 )

@@ -25,7 +25,9 @@ class SimultaneousOptions:
 
     `iteration_budget`: solver iterations all solves of the plan may use together (a capped rung's; no refinement
     round or rebuild starts after that many); `relaxed`: solve the problem relaxed first (a continuation,
-    ocpkit.planner.refinement.RELAXED); `refines`: a motion to start from (guess "motion") instead of `guess`.
+    ocpkit.planner.refinement.RELAXED); `refines`: a motion to start from (guess "motion") instead of `guess`;
+    `pace`: the first solve stops once that many iterations at its pace would not end in its time
+    (PreparedSolver.solve).
     `guess_options` stay a mapping: each guess rule is a plug-in (registry GUESSES) with its own keyword options
     (the "ompl" rule's are ocpkit.planner.ompl_seed.SeedOptions, with `fallback` and `slowdown`)."""
 
@@ -46,6 +48,7 @@ class SimultaneousOptions:
     iteration_budget: float = math.inf
     relaxed: bool = False
     refines: Trajectory | None = field(default=None, compare=False, repr=False)
+    pace: int | None = None
 
     def pseudospectral(self) -> bool:
         """Whether the transcription is pseudospectral (has `segments`)."""

@@ -86,12 +86,13 @@ def margin_step(penetration: float) -> float:
 def solve_refined(discretization: Discretization, solver: PreparedSolver, problem: Problem, guess: np.ndarray,
                   rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf, relaxed: Refinement | None = None,
                   iteration_budget: float = np.inf,
-                  lacking: Callable[[Trajectory], bool] | None = None) -> Refined:
+                  lacking: Callable[[Trajectory], bool] | None = None, pace: int | None = None) -> Refined:
     """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds, all
     before `deadline` (time.perf_counter s); no round starts once the solves have used `iteration_budget`
     iterations, nor once `lacking` says an unverified trajectory needs rows this NLP does not have (screening:
     the caller rebuilds instead). With `relaxed` (continuation), a first solve of the problem
-    relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status."""
+    relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status.
+    `pace` is the first solve's (PreparedSolver.solve): the rounds after it start near a solution."""
     refinement, iterations, taken, timing = Refinement(), 0, 0, []
     if relaxed is not None:
         bounds = discretization.bounds(problem, relaxed)
@@ -102,7 +103,8 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
     while True:
         bounds = discretization.bounds(problem, refinement)
         result = solver.solve(guess, discretization.parameters(problem, refinement), bounds,
-                              max_wall_time=max(deadline - time.perf_counter(), 0.0))
+                              max_wall_time=max(deadline - time.perf_counter(), 0.0),
+                              pace=pace if taken == 0 else None)
         result = checked(result, discretization.nlp.variables, bounds)
         iterations += result.iterations
         trajectory = discretization.decode(result.w)

@@ -117,7 +117,8 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
         made, near = wider
     budget = options.iteration_budget
     refined = solve_refined(made.discretization, made.solver, problem, w, options.refinements, deadline,
-                            RELAXED if options.relaxed else None, budget, _lacking(problem, made, near))
+                            RELAXED if options.relaxed else None, budget, _lacking(problem, made, near),
+                            options.pace)
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
             and time.perf_counter() < deadline and refined.iterations < budget \

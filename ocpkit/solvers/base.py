@@ -77,11 +77,14 @@ class PreparedSolver(ABC):
 
     @abstractmethod
     def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
-              max_wall_time: float | None = None) -> SolverResult:
+              max_wall_time: float | None = None, pace: int | None = None) -> SolverResult:
         """Solve from `guess` (n_w,) with parameters `params` (n_p,) and variable bounds (lbx, ubx) (n_w,) each.
 
         `max_wall_time` (s) replaces the solver's own limit for this call (None: the solver's); a solver that
-        cannot be interrupted reports an overrun as `time_limit` after the fact (its docstring says so)."""
+        cannot be interrupted reports an overrun as `time_limit` after the fact (its docstring says so).
+        `pace`: stop as `time_limit` as soon as this many iterations, at the pace of those so far, would not fit
+        in the call's limit (a solve that cannot converge in time gives its time back early); only the solvers
+        that stop by iteration callback (ipopt, sqpmethod) heed it, the others ignore it."""
 
 
 class Solver(ABC):

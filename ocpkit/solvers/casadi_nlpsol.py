@@ -7,7 +7,8 @@ mapping from `solver.stats()` (`success`, `return_status`, `iter_count`, `unifie
 CasADi RuntimeError during a solve reported as status `failed` with its message instead of an exception.
 
 Time limits: IPOPT and sqpmethod stop through CasADi's `iteration_callback` (`_Deadline`, checked once per
-iteration), at the solver's `max_wall_time` or the one passed to `PreparedSolver.solve` for that call. The same
+iteration), at the solver's `max_wall_time` or the one passed to `PreparedSolver.solve` for that call, and with a
+`pace` as soon as that many iterations at the pace so far would not fit in the limit. The same
 callback stops a diverging solve: an iterate beyond its variable bounds (lbx, ubx) by more than DIVERGED
 (relative to the bound's width, at least 1 in the variable's unit; sqpmethod after a failed QP can step outside
 and come back, so a small excursion is left to the check of the final iterate) is reported `failed` at once
@@ -71,10 +72,15 @@ DIVERGED = 1.0
 """An iterate this far beyond a bound (times the bound's width, at least 1) has diverged."""
 
 
+PACE_FROM = 3
+"""Callback calls (the start and the iterations after it) before a pace is judged: the first ones carry the
+solve's own start-up."""
+
+
 class _Deadline(ca.Callback):
     """nlpsol iteration callback that asks the solver to stop once the deadline (time.perf_counter s) has
-    passed or (when it `watches_bounds`) the iterate has left its bounds; `reason` ("deadline", "bounds" or "")
-    says which."""
+    passed, once its `pace` of iterations cannot end by the deadline, or (when it `watches_bounds`) the iterate has
+    left its bounds; `reason` ("deadline", "pace", "bounds" or "") says which."""
 
     def __init__(self, n_w: int, n_g: int, n_p: int, watches_bounds: bool = True) -> None:
         ca.Callback.__init__(self)
@@ -83,10 +89,12 @@ class _Deadline(ca.Callback):
         self.arm(np.inf, np.full(n_w, -np.inf), np.full(n_w, np.inf))
         self.construct("deadline", {})
 
-    def arm(self, deadline: float, lbx: np.ndarray, ubx: np.ndarray) -> None:
-        """Watch one solve: stop at `deadline` (time.perf_counter s) or when the iterate has diverged from
-        [lbx, ubx] (n_w,) (module docstring)."""
-        self.deadline, self.reason = deadline, ""
+    def arm(self, deadline: float, lbx: np.ndarray, ubx: np.ndarray, pace: int | None = None) -> None:
+        """Watch one solve, from now: stop at `deadline` (time.perf_counter s), as soon as `pace` iterations at the
+        pace so far would end after it, or when the iterate has diverged from [lbx, ubx] (n_w,) (module
+        docstring)."""
+        self.deadline, self.reason, self.pace = deadline, "", pace
+        self.started, self.iterations = time.perf_counter(), 0
         slack = DIVERGED * bound_slack(lbx, ubx) / BOUND_TOLERANCE
         self.lower, self.upper = lbx - slack, ubx + slack
 
@@ -111,18 +119,26 @@ class _Deadline(ca.Callback):
 
     def eval(self, arg: list) -> list:
         try:
+            self.iterations += 1
+            now = time.perf_counter()
             if self.watches_bounds and self._outside(np.asarray(arg[0]).ravel()):
                 self.reason = "bounds"
-            elif time.perf_counter() > self.deadline:
+            elif now > self.deadline:
                 self.reason = "deadline"
+            elif self.pace and self.iterations >= PACE_FROM and \
+                    self.started + self.pace * (now - self.started) / self.iterations > self.deadline:
+                self.reason = "pace"
         except KeyboardInterrupt:  # Ctrl-C landed in this callback: stop the solve (ocpkit.interrupt re-raises it)
             self.reason = "interrupted"
         return [1 if self.reason else 0]
 
 
-_STOPPED = {"deadline": SolverStatus.TIME_LIMIT, "bounds": SolverStatus.FAILED, "interrupted": SolverStatus.FAILED}
+_STOPPED = {"deadline": SolverStatus.TIME_LIMIT, "pace": SolverStatus.TIME_LIMIT, "bounds": SolverStatus.FAILED,
+            "interrupted": SolverStatus.FAILED}
 """Our status when the `_Deadline` callback stopped the solve, by its reason."""
-_STOP_MESSAGES = {"deadline": "stopped at the wall-time limit", "bounds": "stopped: iterate outside its bounds",
+_STOP_MESSAGES = {"deadline": "stopped at the wall-time limit",
+                  "pace": "stopped: at its pace, its iterations would not end within the wall-time limit",
+                  "bounds": "stopped: iterate outside its bounds",
                   "interrupted": "stopped by Ctrl-C"}
 
 
@@ -137,12 +153,13 @@ class PreparedNlpsol(PreparedSolver):
     owner: CasadiNlpsol
 
     def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
-              max_wall_time: float | None = None) -> SolverResult:
-        """See `PreparedSolver.solve`; blocksqp and fatrop cannot be stopped at `max_wall_time` (module docstring)."""
+              max_wall_time: float | None = None, pace: int | None = None) -> SolverResult:
+        """See `PreparedSolver.solve`; blocksqp and fatrop cannot be stopped at `max_wall_time` nor by `pace`
+        (module docstring)."""
         start = time.perf_counter()
         limit = time_limit(self.owner.max_wall_time, max_wall_time)
         if self.deadline is not None:
-            self.deadline.arm(start + limit, *(np.asarray(b, dtype=float) for b in bounds))
+            self.deadline.arm(start + limit, *(np.asarray(b, dtype=float) for b in bounds), pace)
         try:
             with _silenced_stdout():
                 out = self.function(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1],

@@ -267,7 +267,7 @@ class PreparedRipopt(PreparedSolver):
     owner: PyomoRipopt
 
     def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
-              max_wall_time: float | None = None) -> SolverResult:
+              max_wall_time: float | None = None, pace: int | None = None) -> SolverResult:
         guess = np.asarray(guess, dtype=float)
         self.translation.load(guess, np.asarray(params, dtype=float), *(np.asarray(b, dtype=float) for b in bounds))
         limit = time_limit(self.owner.max_wall_time, max_wall_time)

@@ -86,7 +86,7 @@ class PreparedMinimize(PreparedSolver):
     owner: ScipyMinimize
 
     def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
-              max_wall_time: float | None = None) -> SolverResult:
+              max_wall_time: float | None = None, pace: int | None = None) -> SolverResult:
         owner = self.owner
         lbx, ubx = (np.asarray(b, dtype=float) for b in bounds)
         reduced = _Reduced(self.functions, np.asarray(params, dtype=float), lbx, ubx)

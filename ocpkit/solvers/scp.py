@@ -414,7 +414,7 @@ class PreparedScp(PreparedSolver):
     settings: _Settings
 
     def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
-              max_wall_time: float | None = None) -> SolverResult:
+              max_wall_time: float | None = None, pace: int | None = None) -> SolverResult:
         params = np.asarray(params, dtype=float)
         curvature = _ExactCurvature(self.functions, params) if self.functions.hess_f is not None \
             else _DampedBfgs(self.nlp.x.numel())

@@ -22,8 +22,8 @@ from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
 from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_PLANNER,
-                                   OMPL_RESOLUTION, RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered,
-                                   rank)
+                                   OMPL_RESOLUTION, PACE_ITERATIONS, RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer,
+                                   finer_grid, ordered, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow
@@ -186,19 +186,22 @@ def test_a_rung_overrides_only_what_it_names():
                                            "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
-                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300,
+                         "pace": PACE_ITERATIONS}),
     (DEFAULT_LADDER[3], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
                          "guess_options": {"fallback": False, "seed": 1, "planner_name": OMPL_PLANNER,
                                            "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
-                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300,
+                         "pace": PACE_ITERATIONS}),
     (DEFAULT_LADDER[4], {"guess": "ompl", "knots": 16,
                          "guess_options": {"fallback": False, "seed": 2, "planner_name": OMPL_PLANNER,
                                            "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
                                            "resolution": OMPL_RESOLUTION},
-                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
+                         "solver_options": {"max_iterations": 300}, "iteration_budget": 300,
+                         "pace": PACE_ITERATIONS}),
     (DEFAULT_LADDER[5], {"relaxed": True, "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
     (DEFAULT_LADDER[6], {})])
 def test_each_default_rung_changes_the_calls_options_as_it_says(rung, changes):

@@ -88,9 +88,9 @@ class Spy:
     def __init__(self, solver) -> None:
         self.solver, self.calls = solver, []
 
-    def solve(self, guess, parameters, bounds, max_wall_time=None):
+    def solve(self, guess, parameters, bounds, max_wall_time=None, pace=None):
         self.calls.append((np.array(guess), np.array(parameters)))
-        return self.solver.solve(guess, parameters, bounds, max_wall_time=max_wall_time)
+        return self.solver.solve(guess, parameters, bounds, max_wall_time=max_wall_time, pace=pace)
 
 
 @pytest.mark.slow
@@ -112,10 +112,11 @@ class Converges:
     """A solver that 'converges' in `iterations` iterations to the guess it is given, clipped into the bounds."""
 
     def __init__(self, iterations: int) -> None:
-        self.iterations, self.calls = iterations, 0
+        self.iterations, self.calls, self.paces = iterations, 0, []
 
-    def solve(self, guess, parameters, bounds, max_wall_time=None):
+    def solve(self, guess, parameters, bounds, max_wall_time=None, pace=None):
         self.calls += 1
+        self.paces.append(pace)
         return SolverResult(np.clip(guess, *bounds), SolverStatus.CONVERGED, self.iterations, 0.0, "converged")
 
 
@@ -128,6 +129,14 @@ def test_no_refinement_round_starts_once_the_iteration_budget_is_spent(budget, s
     refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2),
                             iteration_budget=budget)
     assert solver.calls == solves and refined.iterations == 100 * solves and not refined.verification.ok
+
+
+def test_only_the_first_solve_keeps_a_pace_the_rounds_start_near_a_solution(monkeypatch):
+    monkeypatch.setattr(sys.modules["ocpkit.planner.refinement"], "next_refinement", lambda *_: Refinement())
+    discretization = build(CASE2, knots=6).discretization
+    solver = Converges(10)
+    solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), rounds=2, pace=100)
+    assert solver.paces == [100, None, None]
 
 
 def test_no_refinement_round_starts_once_the_motion_needs_rows_the_nlp_lacks(monkeypatch):
@@ -151,9 +160,9 @@ def test_a_round_starts_from_the_last_solution_relifted_at_its_own_check_slots(m
     seen = []
 
     class Records(Converges):
-        def solve(self, guess, parameters, bounds, max_wall_time=None):
+        def solve(self, guess, parameters, bounds, max_wall_time=None, pace=None):
             seen.append(np.array(guess))
-            return super().solve(guess, parameters, bounds, max_wall_time)
+            return super().solve(guess, parameters, bounds, max_wall_time, pace)
 
     w = discretization.initial_guess(CASE2)
     solve_refined(discretization, Records(10), CASE2, w, rounds=1)

@@ -102,6 +102,15 @@ def test_a_per_call_time_limit_overrides_the_solvers_own(name):
     assert prepared.solve(GUESS, PARAMS, BOUNDS).status == SolverStatus.CONVERGED  # the next call: its own again
 
 
+@pytest.mark.parametrize("name", ["ipopt", "sqpmethod"])
+def test_a_solve_whose_pace_cannot_fit_its_iterations_in_its_time_stops_early(name):
+    prepared = ALL_SOLVERS[name](max_wall_time=60.0).prepare(rosenbrock_disk())
+    hopeless = prepared.solve(GUESS, PARAMS, BOUNDS, pace=10**12)  # 10¹² iterations cannot fit in 60 s
+    assert hopeless.status == SolverStatus.TIME_LIMIT and "pace" in hopeless.message
+    assert hopeless.iterations < 5
+    assert prepared.solve(GUESS, PARAMS, BOUNDS, pace=100).status == SolverStatus.CONVERGED  # fast enough
+
+
 @pytest.mark.parametrize("name", ["blocksqp", "fatrop"])
 def test_an_uninterruptible_solver_reports_an_overrun_of_the_per_call_limit(name):
     prepared = ALL_SOLVERS[name](max_wall_time=60.0, max_iterations=2).prepare(rosenbrock_disk())

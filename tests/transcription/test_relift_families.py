@@ -28,7 +28,7 @@ class AtTheGuess:
     def __init__(self) -> None:
         self.starts: list[np.ndarray] = []
 
-    def solve(self, guess, parameters, bounds, max_wall_time=None):
+    def solve(self, guess, parameters, bounds, max_wall_time=None, pace=None):
         self.starts.append(np.array(guess))
         return SolverResult(np.clip(guess, *bounds), SolverStatus.CONVERGED, 1, 0.0, "converged")
 
