@@ -91,7 +91,9 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     """One plan with `options`: build, guess, solve with refinement rounds, all within `max_wall_time` (s) of
     computation and set-up. A guess rule with no start to offer (NoGuess) ends the plan as `no_path` before any
     solve, holding the start (a dense check of a placeholder motion would only spend the budget: seconds on a
-    robot with thousands of sphere pairs). With screening (ocpkit.planner.screening) the first build keeps the
+    robot with thousands of sphere pairs); one that ends past the deadline (a long path search after a long
+    build) ends the plan as `time_limit` with the guess's motion, without the rebuild or solve that could only
+    overrun. With screening (ocpkit.planner.screening) the first build keeps the
     collision rows near the straight line; a guess or an unverified solution that comes near rows left out is
     solved again on a rebuild with them added."""
     started = time.perf_counter()
@@ -113,6 +115,10 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
                       message=f"guess {guess!r}: {exc}; not solved, the plan holds the start")
     guess_time = time.perf_counter() - guessing
     first_setup = made.setup_time
+    if time.perf_counter() >= deadline:  # the build and the guess took all the time: no rebuild, no solve
+        return finish(problem, made.discretization.decode(w), "time_limit", method, started,
+                      setup_time=first_setup, message="the time ran out in the guess, before the first solve",
+                      timing=Timing(guess=guess_time, setup=made.setup_parts))
     if near is not None and (wider := _widened(problem, options, made, near, made.discretization.decode(w))):
         made, near = wider
     budget = options.iteration_budget

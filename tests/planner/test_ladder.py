@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 
 import numpy as np
 import pytest
@@ -359,6 +360,16 @@ def test_a_path_search_ends_by_the_plans_deadline_whatever_planning_time_it_was_
     plan_simultaneous(CASE2, knots=6, guess="searching", guess_options={"planning_time": 100.0}, max_wall_time=5.0,
                       fallbacks=())
     assert 0.0 < given[0] < 5.0  # what is left of 5 s after the build, not the 100 s asked for
+
+
+def test_a_guess_that_ends_past_the_deadline_ends_the_plan_time_limit_without_a_solve(monkeypatch):
+    def slow(problem, discretization, fallback=True):
+        time.sleep(0.3)
+        return discretization.initial_guess(problem)
+
+    monkeypatch.setitem(GUESSES._items, "slow", slow)
+    plan = plan_simultaneous(CASE2, knots=6, guess="slow", max_wall_time=0.2, fallbacks=())
+    assert plan.status == "time_limit" and plan.stats.iterations == 0 and "guess" in plan.stats.solver_message
 
 
 class Recording(Script):
