@@ -54,7 +54,7 @@ An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as t
 of its iterations so far, would not end within the rung's time. Where an iteration is slow (a large NLP: the
 Fetch's thousands of self-collision rows) and the path search has taken much of the rung's share, the solve would
 end at its time limit anyway, most often unconverged: it gives that time to the safety net, which times the same
-path, instead. A hundred iterations is where most solves that converge have (the first rung's cap); a solve
+path, instead. Most solves that converge do so within a hundred iterations (the first rung's cap); a solve
 whose iterations are fast enough never notices the pace.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
