@@ -133,13 +133,15 @@ class Screening:
 @dataclass(frozen=True)
 class PathStats:
     """A decomposition baseline's path: configurations checked for collision, waypoints, smoothing repair rounds,
-    the clearance margin planned with (m), and TOPP-RA's t_f (s; None where not reported)."""
+    the clearance margin planned with (m), TOPP-RA's t_f (s; None where not reported) and the path searches made
+    (ocpkit.planner.ompl_seed.ompl_path searches a slow path again)."""
 
     validity_checks: int
     waypoints: int
     repair_rounds: int
     margin: float
     toppra_tf: float | None = None
+    searches: int = 1
 
 
 @dataclass(frozen=True)
@@ -167,7 +169,8 @@ class PlanStats:
     def figures(self) -> dict:
         """The planner's own figures as JSON (results.csv's `extra` column): `timing` {guess (where there was
         one), rounds, setup} of a plan that guessed or solved; a baseline's path_time_s, simplify_time_s,
-        smooth_time_s, toppra_time_s, validity_checks, waypoints, repair_rounds, margin_m (and toppra_tf_s);
+        smooth_time_s, toppra_time_s, validity_checks, waypoints, repair_rounds, margin_m, path_searches (and
+        toppra_tf_s);
         `screening` {rows_per_point, rebuilds}; a ladder's `rungs` [{rung, status, time_s, iterations}] and
         `skipped`; `hint`; then `extra`."""
         t, figures = self.timing, {}
@@ -180,7 +183,8 @@ class PlanStats:
                 figures[key] = seconds
         if self.path is not None:
             figures.update(validity_checks=self.path.validity_checks, waypoints=self.path.waypoints,
-                           repair_rounds=self.path.repair_rounds, margin_m=self.path.margin)
+                           repair_rounds=self.path.repair_rounds, margin_m=self.path.margin,
+                           path_searches=self.path.searches)
             if self.path.toppra_tf is not None:
                 figures["toppra_tf_s"] = self.path.toppra_tf
         if self.screening is not None:

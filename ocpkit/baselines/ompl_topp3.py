@@ -180,5 +180,6 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
                f"{result.message}")
     return finish(problem, refined.trajectory, stopped, method, began, setup_time=setup + timing.setup_time,
                   iterations=refined.iterations, rounds=refined.rounds, message=message, timing=spent,
-                  path=PathStats(free.checks, len(found.waypoints), rounds, free.margin, timing.toppra_tf),
+                  path=PathStats(free.checks, len(found.waypoints), rounds, free.margin, timing.toppra_tf,
+                                 found.searches),
                   verification=refined.verification, hints=TOPP3_HINTS)

@@ -85,6 +85,9 @@ TORQUE_RATE_WINDOW = 1e-3  # s
 MAX_STEP = 1.0  # rad: an RRT's longest extension (OMPL's `range`; module docstring)
 SEGMENT_BATCH = 16  # configurations counted for a segment's first batch; later batches double (`segment_free`)
 FOUND_PATHS = 4  # paths kept for a repeated search (`ompl_path`)
+SLOW_PATH = 0.6  # of the problem's longest motion time: a path whose `time_floor` is longer is searched again
+SEARCHES = 3  # searches at most for one path, the first included (`ompl_path`)
+SEED_STRIDE = 1000  # a repeated search's seed is seed + k SEED_STRIDE: clear of the seeds callers pass (0, 1, 2, ...)
 
 
 class FreeSpace:
@@ -236,15 +239,24 @@ def _termination(ob: Any, free: FreeSpace, planning_time: float, max_checks: int
 
 @dataclass(frozen=True)
 class OmplPath:
-    """Simplified waypoints (k, n) from start to goal, or None without an exact path; times in seconds."""
+    """Simplified waypoints (k, n) from start to goal, or None without an exact path; times in seconds, summed over
+    the `searches` made (`ompl_path`)."""
 
     waypoints: np.ndarray | None
     path_time: float
     simplify_time: float
+    searches: int = 1
 
 
-_found: OrderedDict[tuple, tuple[Problem, np.ndarray, int]] = OrderedDict()
-"""The last FOUND_PATHS paths found: (problem, waypoints, configurations checked) by (id(problem), the search's
+def time_floor(robot: Robot, waypoints: np.ndarray) -> float:
+    """The time (s) a robot needs to follow `waypoints` (k, n) at its joint velocity limits, without accelerating:
+    each straight segment takes its slowest joint's |Δq| / qd_max. No timing of the path is faster (a smoothed
+    path cuts corners by little); it is the cheap score a path search compares paths by (`ompl_path`)."""
+    return float((np.abs(np.diff(waypoints, axis=0)) / robot.qd_max).max(axis=1, initial=0.0).sum())
+
+
+_found: OrderedDict[tuple, tuple[Problem, np.ndarray, int, int]] = OrderedDict()
+"""The last FOUND_PATHS paths found: (problem, waypoints, configurations checked, searches) by (id(problem), the search's
 options but its budgets); the problem is held so that its id is not reused while the entry lives."""
 
 
@@ -257,6 +269,12 @@ def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_tim
     options, a `max_checks` at least the checks that search took) gets the path found then, without searching
     again (no time; `free` counts the checks it took), if it is among the last FOUND_PATHS found.
 
+    A path whose `time_floor` exceeds SLOW_PATH times the problem's longest motion time (time.max) leaves its
+    timing little room: the torque, torque-rate and jerk terms slow a motion well past its velocity limits'. Such a
+    path is searched again with other seeds (seed + k SEED_STRIDE), up to SEARCHES searches in all, within the same
+    budgets (the seconds from the call, the checks counted by `free`), and the fastest path by `time_floor` is kept.
+    RRTConnect's paths between the same start and goal differ several-fold in that time from seed to seed.
+
     The time budget is OMPL's own timer. A check budget is a Python condition, safe only for planners that plan in
     the calling thread (RRTConnect, RRT*, BIT*, LBKPIECE1): PRM checks for a solution in a second thread, which
     would deadlock waiting for the interpreter lock that the planning thread holds. A planner of two stages
@@ -267,17 +285,38 @@ def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_tim
         raise OptionError("max_checks cannot stop prm (it plans in a second thread); give it a planning_time")
     key = (id(problem), free.margin, planner_name, seed, resolution, max_step)
     if key in _found and _found[key][0] is problem:
-        _, waypoints, checks = _found[key]
+        _, waypoints, checks, searches = _found[key]
         if max_checks is not None and checks <= max_checks:
             free.checks += checks
-            return OmplPath(waypoints, 0.0, 0.0)
-    before = free.checks
+            return OmplPath(waypoints, 0.0, 0.0, searches)
+    before, began = free.checks, time.perf_counter()
     found = _search(problem, free, planner_name, planning_time, seed, resolution, max_checks, max_step)
+    while found.waypoints is not None and found.searches < SEARCHES and _slow(problem, found.waypoints):
+        left = planning_time - (time.perf_counter() - began)
+        if left <= 0 or (max_checks is not None and free.checks >= max_checks):
+            break
+        again = _search(problem, free, planner_name, left, seed + found.searches * SEED_STRIDE, resolution,
+                        max_checks, max_step)
+        found = _faster(problem.robot, found, again)
     if found.waypoints is not None:
-        _found[key] = problem, found.waypoints, free.checks - before
+        _found[key] = problem, found.waypoints, free.checks - before, found.searches
         while len(_found) > FOUND_PATHS:
             _found.popitem(last=False)
     return found
+
+
+def _slow(problem: Problem, waypoints: np.ndarray) -> bool:
+    """Whether the path `waypoints` (k, n) takes longer than SLOW_PATH × time.max (s) at the velocity limits."""
+    return time_floor(problem.robot, waypoints) > SLOW_PATH * problem.time.max
+
+
+def _faster(robot: Robot, first: OmplPath, then: OmplPath) -> OmplPath:
+    """Of two searches' paths, the one with the smaller `time_floor` (the first when the second found none), with
+    both searches' times and counts."""
+    kept = first if then.waypoints is None or time_floor(robot, first.waypoints) <= time_floor(robot, then.waypoints) \
+        else then
+    return OmplPath(kept.waypoints, first.path_time + then.path_time, first.simplify_time + then.simplify_time,
+                    first.searches + then.searches)
 
 
 def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
@@ -521,7 +560,7 @@ def ompl_seed(problem: Problem, options: SeedOptions = SeedOptions()) -> Seed:
     timing = time.perf_counter()
     timed = time_optimal(problem, path, options.grid_points)
     spent = dataclasses.replace(searched, smooth=timing - smoothing, path_timing=time.perf_counter() - timing)
-    figures = PathStats(free.checks, len(path.ss_waypoints), rounds, free.margin)
+    figures = PathStats(free.checks, len(path.ss_waypoints), rounds, free.margin, searches=found.searches)
     if timed is None:
         return Seed(None, "infeasible", "TOPP-RA: the path cannot be timed within the limits", setup, spent, figures)
     motion, knot_times = timed

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import time
+from types import SimpleNamespace
 
 import numpy as np
 import pinocchio as pin
@@ -201,3 +202,63 @@ def test_ompl_counts_a_slow_joints_move_by_its_time_and_its_paths_end_exactly_at
 def test_a_robot_without_slow_joints_plans_in_radians():
     panda = ocpkit.load_scenario(REPO / "scenarios/mbm/panda/box/0001.yaml").robot
     np.testing.assert_array_equal(ompl_seed_module.time_scale(panda), np.ones(panda.n))
+
+
+def test_the_time_floor_is_each_segments_slowest_joint_at_its_limit():
+    robot = type("Limits", (), {"qd_max": np.array([1.0, 2.0])})()
+    waypoints = np.array([[0.0, 0.0], [1.0, 0.5], [1.0, 2.0], [0.0, 2.0]])
+    assert ompl_seed_module.time_floor(robot, waypoints) == pytest.approx(1.0 + 0.75 + 1.0)
+    assert ompl_seed_module.time_floor(robot, waypoints[:1]) == 0.0
+
+
+@pytest.fixture
+def searches_by_seed(monkeypatch):
+    """`_search` replaced by a stand-in whose path for seed s moves the first joint out and back over
+    `floors[s]` seconds at its velocity limit (no path for a seed not there); the seeds searched are in `asked`."""
+    searches = SimpleNamespace(asked=[], floors={})
+
+    def search(problem, free, planner_name, planning_time, seed, *args):
+        searches.asked.append(seed)
+        floor = searches.floors.get(seed)
+        if floor is None:
+            return ompl_seed_module.OmplPath(None, 0.1, 0.0)
+        out = problem.start.copy()
+        out[0] += floor / 2 * problem.robot.qd_max[0]
+        return ompl_seed_module.OmplPath(np.array([problem.start, out, problem.start]), 0.1, 0.01)
+
+    monkeypatch.setattr(ompl_seed_module, "_search", search)
+    ompl_seed_module._found.clear()
+    return searches
+
+
+def test_a_slow_path_is_searched_again_and_the_fastest_kept(case1, searches_by_seed):
+    problem = dataclasses.replace(case1, time=dataclasses.replace(case1.time, max=10.0))
+    slow, faster, fastest_but_slow = 0.7 * 10.0, 0.65 * 10.0, 0.62 * 10.0  # all over SLOW_PATH = 0.6 of time.max
+    searches_by_seed.floors = {0: slow, 1000: fastest_but_slow, 2000: faster}
+    found = ompl_seed_module.ompl_path(problem, ompl_seed_module.planning_space(problem, 0.01), "rrtconnect", 5.0, 0,
+                                       0.02)
+    assert searches_by_seed.asked == [0, 1000, 2000] and found.searches == ompl_seed_module.SEARCHES == 3
+    assert ompl_seed_module.time_floor(problem.robot, found.waypoints) == pytest.approx(fastest_but_slow)
+    assert found.path_time == pytest.approx(0.3) and found.simplify_time == pytest.approx(0.03)
+
+
+def test_a_path_fast_enough_or_found_again_is_searched_once(case1, searches_by_seed):
+    problem = dataclasses.replace(case1, time=dataclasses.replace(case1.time, max=10.0))
+    searches_by_seed.floors = {3: 0.5 * 10.0, 1003: 0.1}
+    found = ompl_seed_module.ompl_path(problem, ompl_seed_module.planning_space(problem, 0.01), "rrtconnect", 5.0, 3,
+                                       0.02, max_checks=10**6)
+    assert searches_by_seed.asked == [3] and found.searches == 1
+    searches_by_seed.floors = {4: 0.9 * 10.0}  # slow, and no second path: the first is kept
+    found = ompl_seed_module.ompl_path(problem, ompl_seed_module.planning_space(problem, 0.01), "rrtconnect", 5.0, 4,
+                                       0.02, max_checks=10**6)
+    assert searches_by_seed.asked == [3, 4, 1004, 2004] and found.searches == 3 and found.waypoints is not None
+    again = ompl_seed_module.ompl_path(problem, ompl_seed_module.planning_space(problem, 0.01), "rrtconnect", 5.0, 4,
+                                       0.02, max_checks=10**6)
+    assert searches_by_seed.asked == [3, 4, 1004, 2004] and again.waypoints is found.waypoints and again.searches == 3
+
+
+def test_no_search_again_once_the_time_is_spent(case1, searches_by_seed):
+    problem = dataclasses.replace(case1, time=dataclasses.replace(case1.time, max=10.0))
+    searches_by_seed.floors = {0: 9.0, 1000: 1.0}
+    ompl_seed_module.ompl_path(problem, ompl_seed_module.planning_space(problem, 0.01), "rrtconnect", 0.0, 0, 0.02)
+    assert searches_by_seed.asked == [0]
