@@ -1,7 +1,8 @@
 """The build cache: one Discretization and prepared solver per problem shape, shared by every query of it.
 
 `build(problem, ...)` returns the Discretization of the problem's shape and a solver prepared for its NLP,
-building both on first use. The key is the transcription's options, the dynamics backend (its robot's content
+building both on first use; `shape` then `prepare` does the same in two steps, so a plan can screen its collision
+rows by its guess, found on the first Discretization, before it prepares a solver (ocpkit.planner.simultaneous). The key is the transcription's options, the dynamics backend (its robot's content
 included), each constraint's shape, the solver and its options: start, goal, time bounds, μ and obstacle
 positions are numbers, so queries that differ only in them share a build. The cache holds the most recently used
 builds within a memory budget (`memory_budget`): each build's size is estimated as the growth of the process's
@@ -32,7 +33,7 @@ from ocpkit.planner.screening import screened
 from ocpkit.problem import Problem
 from ocpkit.registry import construct
 from ocpkit.solvers import SOLVERS, PreparedSolver
-from ocpkit.solvers.base import STAGES_NEEDED
+from ocpkit.solvers.base import STAGES_NEEDED, Solver
 from ocpkit.solvers.compiled import compile_seconds
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
 from ocpkit.transcription.ocp import OCP
@@ -60,6 +61,20 @@ class Build:
 _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
 
 
+@dataclass(frozen=True)
+class Shaped:
+    """A problem shape's Discretization whose solver is not prepared yet (`prepare`): a cached build's, or a new one
+    whose graph took `graph_time` s. The step between lets a plan look at its guess on the discretization, and
+    screen again, before it pays for the solver."""
+
+    discretization: Discretization
+    key: tuple
+    solver: Solver  # to prepare for the discretization's NLP
+    cached: Build | None
+    graph_time: float
+    resident: int  # bytes of resident memory before the graph was built
+
+
 def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str | Dynamics = "casadi-rnea",
           solver: str = "ipopt", constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
           transcription_options: dict | None = None, solver_options: dict | None = None,
@@ -67,7 +82,18 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     """The build for `problem`'s shape (module docstring): components by registered name (`ocpkit list`), a
     dynamics backend also as an instance; unknown options raise OptionError. `ocp` is the OCP to discretize:
     the robot OCP of `problem` by default (ocpkit.transcription.ocp). With `near` (K, n), the constraints keep only
-    the rows that can be active near those configurations (ocpkit.planner.screening)."""
+    the rows that can be active near those configurations (ocpkit.planner.screening). `shape` then `prepare` is
+    the same in two steps."""
+    return prepare(shape(problem, transcription, knots, dynamics, solver, constraints, transcription_options,
+                         solver_options, dynamics_options, ocp, near))
+
+
+def shape(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str | Dynamics = "casadi-rnea",
+          solver: str = "ipopt", constraints: Sequence[str | type[Constraint]] = DEFAULT_CONSTRAINTS,
+          transcription_options: dict | None = None, solver_options: dict | None = None,
+          dynamics_options: dict | None = None, ocp: OCP | None = None, near: np.ndarray | None = None) -> Shaped:
+    """`build`'s first step: the Discretization of the shape (the cached build's when there is one), its solver not
+    prepared."""
     options = solver_options or {}
     transcription_options = _staged_for(solver, options, transcription, transcription_options or {})
     method = construct(TRANSCRIPTIONS.get(transcription), transcription, {"knots": knots, **transcription_options})
@@ -76,18 +102,27 @@ def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     nlp_solver = construct(SOLVERS.get(solver), solver, options)  # a wrong name or option fails before a build
     key = (method.shape_key(backend, plugins, ocp), solver, frozen(options))
     if key in _BUILDS:
-        _BUILDS.move_to_end(key)
-        return Build(_BUILDS[key].discretization, _BUILDS[key].solver, 0.0)
+        return Shaped(_BUILDS[key].discretization, key, nlp_solver, _BUILDS[key], 0.0, 0)
     began, resident = time.perf_counter(), _resident()
     discretization = method.build(problem, backend, plugins, ocp)
-    built, compiling = time.perf_counter(), compile_seconds()
-    prepared = nlp_solver.prepare(discretization.nlp)
+    return Shaped(discretization, key, nlp_solver, None, time.perf_counter() - began, resident)
+
+
+def prepare(shaped: Shaped, graph_time: float | None = None) -> Build:
+    """`build`'s second step: the solver of `shaped` prepared, the build cached (or the cached build, set-up 0).
+    `graph_time` (s): the graph's time to report, when more than this shape's graph was built on the way."""
+    if shaped.cached is not None:
+        _BUILDS.move_to_end(shaped.key)
+        return Build(shaped.cached.discretization, shaped.cached.solver, 0.0)
+    graph = shaped.graph_time if graph_time is None else graph_time
+    began, compiling = time.perf_counter(), compile_seconds()
+    prepared = shaped.solver.prepare(shaped.discretization.nlp)
     ended, compiled = time.perf_counter(), compile_seconds() - compiling
-    _BUILDS[key] = Build(discretization, prepared, ended - began,
-                         {"graph": built - began, "solver": ended - built - compiled, "compile": compiled},
-                         max(_resident() - resident, SMALLEST_BUILD))
+    _BUILDS[shaped.key] = Build(shaped.discretization, prepared, graph + ended - began,
+                                {"graph": graph, "solver": ended - began - compiled, "compile": compiled},
+                                max(_resident() - shaped.resident, SMALLEST_BUILD))
     _evict(memory_budget())
-    return _BUILDS[key]
+    return _BUILDS[shaped.key]
 
 
 def _evict(budget: int) -> None:

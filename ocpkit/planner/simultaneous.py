@@ -21,7 +21,7 @@ from ocpkit.formats.trajectory import Trajectory
 from ocpkit.geometry.clearances import buried, sphere_centers_batch
 from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, PLANNERS, screening
-from ocpkit.planner.build_cache import Build, build
+from ocpkit.planner.build_cache import Build, Shaped, prepare, shape
 from ocpkit.planner.guesses import STRAIGHT_LINE_RULES
 from ocpkit.planner.ladder import (DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, Rung,
                                    climb, ordered)
@@ -93,14 +93,16 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     solve, holding the start (a dense check of a placeholder motion would only spend the budget: seconds on a
     robot with thousands of sphere pairs); one that ends past the deadline (a long path search after a long
     build) ends the plan as `time_limit` with the guess's motion, without the rebuild or solve that could only
-    overrun. With screening (ocpkit.planner.screening) the first build keeps the
-    collision rows near the straight line; a guess or an unverified solution that comes near rows left out is
-    solved again on a rebuild with them added."""
+    overrun. With screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight
+    line. A guess that comes near rows left out is screened again, with them added, before the solver is prepared
+    (a solver's preparation is most of a build); an unverified solution that does is solved again on a rebuild.
+    The builds before the first solve are the plan's set-up, a rebuild after it is computation."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
     options = _checked_near_the_ends(problem, options)
     deadline = started + max_wall_time  # the set-up counts against the budget too
-    made = _build(problem, options, near)
+    shaped = _shape(problem, options, near)
+    graph_time = shaped.graph_time
     dynamics = options.dynamics
     method = {"planner": "simultaneous", "transcription": options.transcription, "knots": options.knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options.solver}
@@ -109,18 +111,22 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     if "planning_time" in guess_options:  # a path search ends by the plan's deadline, after this rung's build
         guess_options["planning_time"] = min(guess_options["planning_time"], max(deadline - guessing, 0.0))
     try:
-        w = _guess(problem, made.discretization, guess, guess_options)
+        w = _guess(problem, shaped.discretization, guess, guess_options)
     except NoGuess as exc:  # no motion to report: the robot holds its start, as in the baselines' no_path plans
-        return finish(problem, hold(problem), "no_path", method, started, setup_time=made.setup_time,
+        return finish(problem, hold(problem), "no_path", method, started, setup_time=graph_time,
                       message=f"guess {guess!r}: {exc}; not solved, the plan holds the start")
     guess_time = time.perf_counter() - guessing
-    first_setup = made.setup_time
     if time.perf_counter() >= deadline:  # the build and the guess took all the time: no rebuild, no solve
-        return finish(problem, made.discretization.decode(w), "time_limit", method, started,
-                      setup_time=first_setup, message="the time ran out in the guess, before the first solve",
-                      timing=Timing(guess=guess_time, setup=made.setup_parts))
-    if near is not None and (wider := _widened(problem, options, made, near, made.discretization.decode(w))):
-        made, near = wider
+        return finish(problem, shaped.discretization.decode(w), "time_limit", method, started,
+                      setup_time=graph_time, message="the time ran out in the guess, before the first solve",
+                      timing=Timing(guess=guess_time, setup={"graph": graph_time}))
+    if near is not None and (samples := _near_left_out(problem, shaped.discretization,
+                                                       shaped.discretization.decode(w))) is not None:
+        near = np.vstack([near, samples])  # screened again by the guess before the solver is prepared
+        shaped, w = _reshaped(problem, options, near, shaped, w)
+        graph_time += shaped.graph_time
+    made = prepare(shaped, graph_time)
+    first_setup = made.setup_time or graph_time  # a cached build: the graphs built on the way
     budget = options.iteration_budget
     refined = solve_refined(made.discretization, made.solver, problem, w, options.refinements, deadline,
                             RELAXED if options.relaxed else None, budget, _lacking(problem, made, near),
@@ -178,11 +184,22 @@ def _checked_near_the_ends(problem: Problem, options: SimultaneousOptions) -> Si
     return dataclasses.replace(options, transcription_options={**options.transcription_options, "end_checks": True})
 
 
-def _build(problem: Problem, options: SimultaneousOptions, near: np.ndarray | None) -> Build:
-    """The build of `options`, its collision rows screened by `near`."""
-    return build(problem, options.transcription, options.knots, options.dynamics, options.solver,
+def _shape(problem: Problem, options: SimultaneousOptions, near: np.ndarray | None) -> Shaped:
+    """The shape of `options` (its solver not prepared: ocpkit.planner.build_cache), its collision rows screened by
+    `near`."""
+    return shape(problem, options.transcription, options.knots, options.dynamics, options.solver,
                  options.constraints, dict(options.transcription_options), dict(options.solver_options),
                  options.dynamics_options, near=near)
+
+
+def _reshaped(problem: Problem, options: SimultaneousOptions, near: np.ndarray, before: Shaped,
+              w: np.ndarray) -> tuple[Shaped, np.ndarray]:
+    """The shape screened by `near` instead of `before`'s, and the guess `w` of `before` as its decision vector:
+    the same where screening left the variables as they were (it only drops constraint rows), else re-encoded."""
+    shaped = _shape(problem, options, near)
+    if shaped.discretization.nlp.variables.size != w.size:
+        w = shaped.discretization.encode(before.discretization.decode(w))
+    return shaped, w
 
 
 def _lacking(problem: Problem, made: Build, near: np.ndarray | None) -> Callable[[Trajectory], bool] | None:
@@ -190,24 +207,25 @@ def _lacking(problem: Problem, made: Build, near: np.ndarray | None) -> Callable
     rounds so the plan rebuilds with them instead; None without screening."""
     if near is None:
         return None
-    return lambda motion: _near_left_out(problem, made, motion) is not None
+    return lambda motion: _near_left_out(problem, made.discretization, motion) is not None
 
 
-def _near_left_out(problem: Problem, made: Build, motion: Trajectory) -> np.ndarray | None:
-    """Samples (K, n) of `motion` when it comes near rows `made` left out (ocpkit.planner.screening), else None."""
+def _near_left_out(problem: Problem, discretization: Discretization, motion: Trajectory) -> np.ndarray | None:
+    """Samples (K, n) of `motion` when it comes near rows `discretization` left out (ocpkit.planner.screening), else
+    None."""
     samples = screening.motion_samples(motion)
-    return samples if screening.missing(problem, made.discretization.constraints, samples) else None
+    return samples if screening.missing(problem, discretization.constraints, samples) else None
 
 
 def _widened(problem: Problem, options: SimultaneousOptions, made: Build, near: np.ndarray,
              motion: Trajectory) -> tuple[Build, np.ndarray] | None:
     """The rebuild screened by `near` and samples of `motion` when `motion` comes near rows `made` left out, with
     those configurations (K, n); None when it does not."""
-    samples = _near_left_out(problem, made, motion)
+    samples = _near_left_out(problem, made.discretization, motion)
     if samples is None:
         return None
     near = np.vstack([near, samples])
-    return _build(problem, options, near), near
+    return prepare(_shape(problem, options, near)), near
 
 
 def _continued(before: Refined, after: Refined) -> Refined:

@@ -11,6 +11,7 @@ from ocpkit.constraints import make_constraints
 from ocpkit.constraints.collision import SphereCollision
 from ocpkit.formats.scenario import load_scenario
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
+from ocpkit.planner.build_cache import clear_builds
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.screening import (CROWDED_DISTANCE, CROWDED_ROWS, SCREEN_DISTANCE, line_samples, missing,
                                      screenable_rows, screened, worth_screening)
@@ -98,3 +99,26 @@ def test_a_plan_checks_near_the_ends_when_an_end_is_close_to_contact_unless_told
     assert _checked_near_the_ends(PANDA, told) is told
     mesh = dataclasses.replace(PLAN_OPTIONS, transcription="trapezoidal")
     assert _checked_near_the_ends(PANDA, mesh) is mesh  # a mesh transcription has no such option
+
+
+def test_a_guess_near_left_out_rows_is_screened_again_before_the_solver_is_prepared(monkeypatch):
+    import ocpkit.planner.simultaneous as simultaneous
+
+    steps, real_shape, real_prepare, real_near = [], simultaneous.shape, simultaneous.prepare, \
+        simultaneous._near_left_out
+    monkeypatch.setattr(simultaneous, "shape", lambda *a, **k: steps.append("shape") or real_shape(*a, **k))
+    monkeypatch.setattr(simultaneous, "prepare", lambda *a, **k: steps.append("prepare") or real_prepare(*a, **k))
+
+    def near_for_the_guess(problem, discretization, motion):  # the guess comes near rows left out, as if
+        if steps == ["shape"]:
+            return line_samples(problem) + 0.05
+        return real_near(problem, discretization, motion)
+
+    monkeypatch.setattr(simultaneous, "_near_left_out", near_for_the_guess)
+    clear_builds()
+    plan = plan_simultaneous(PANDA, fallbacks=(), screen=True, knots=6, refinements=0,
+                             solver_options={"max_iterations": 2})
+    assert steps[:3] == ["shape", "shape", "prepare"]  # one solver prepared, for the shape screened by the guess too
+    setup = plan.stats.timing.setup
+    assert setup["graph"] > 0 and setup["solver"] > 0
+    assert plan.stats.setup_time == pytest.approx(setup["graph"] + setup["solver"] + setup["compile"])
