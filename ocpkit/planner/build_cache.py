@@ -2,9 +2,10 @@
 
 `build(problem, ...)` returns the Discretization of the problem's shape and a solver prepared for its NLP,
 building both on first use; `shape` then `prepare` does the same in two steps, so a plan can screen its collision
-rows by its guess, found on the first Discretization, before it prepares a solver (ocpkit.planner.simultaneous). The key is the transcription's options, the dynamics backend (its robot's content
-included), each constraint's shape, the solver and its options: start, goal, time bounds, μ and obstacle
-positions are numbers, so queries that differ only in them share a build. The cache holds the most recently used
+rows by its guess, found on the first Discretization, before it prepares a solver (ocpkit.planner.simultaneous).
+The key is the transcription's options, the dynamics backend (its robot's content included), each constraint's
+shape, the solver and its options: start, goal, time bounds, μ and obstacle positions are numbers, so queries that
+differ only in them share a build. The cache holds the most recently used
 builds within a memory budget (`memory_budget`): each build's size is estimated as the growth of the process's
 resident memory while it was made, and the least recently used builds are dropped while the estimates add up to
 more than the budget or the process's resident memory exceeds it (the newest always stays); dropped builds' memory

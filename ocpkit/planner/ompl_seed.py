@@ -256,8 +256,8 @@ def time_floor(robot: Robot, waypoints: np.ndarray) -> float:
 
 
 _found: OrderedDict[tuple, tuple[Problem, np.ndarray, int, int]] = OrderedDict()
-"""The last FOUND_PATHS paths found: (problem, waypoints, configurations checked, searches) by (id(problem), the search's
-options but its budgets); the problem is held so that its id is not reused while the entry lives."""
+"""The last FOUND_PATHS paths found: (problem, waypoints, configurations checked, searches) by (id(problem), the
+search's options but its budgets); the problem is held so that its id is not reused while the entry lives."""
 
 
 def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
