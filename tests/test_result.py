@@ -95,7 +95,7 @@ def test_a_baselines_figures_keep_their_flat_keys(motion):
                    verification=PASSED, found=False).stats
     assert stats.figures() == {"path_time_s": 0.2, "simplify_time_s": 0.05, "smooth_time_s": 0.0,
                                "toppra_time_s": 0.0, "validity_checks": 4240, "waypoints": 0, "repair_rounds": 0,
-                               "margin_m": 0.01}
+                               "margin_m": 0.01, "path_searches": 1}
     timed = dataclasses.replace(stats, path=PathStats(4240, 3, 1, 0.01, toppra_tf=0.9), extra={"own": "x"})
     assert (timed.figures()["toppra_tf_s"], timed.figures()["own"]) == (0.9, "x")
     assert PlanStats(1.0, 0.0, 0, 0, "").figures() == {}

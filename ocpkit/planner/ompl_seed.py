@@ -270,7 +270,7 @@ def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_tim
     again (no time; `free` counts the checks it took), if it is among the last FOUND_PATHS found.
 
     A path whose `time_floor` exceeds SLOW_PATH times the problem's longest motion time (time.max) leaves its
-    timing little room: the torque, torque-rate and jerk terms slow a motion well past its velocity limits'. Such a
+    timing little room: the torque, torque-rate and jerk terms make a motion far slower than that floor. Such a
     path is searched again with other seeds (seed + k SEED_STRIDE), up to SEARCHES searches in all, within the same
     budgets (the seconds from the call, the checks counted by `free`), and the fastest path by `time_floor` is kept.
     RRTConnect's paths between the same start and goal differ several-fold in that time from seed to seed.

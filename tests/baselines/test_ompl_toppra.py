@@ -142,7 +142,7 @@ def test_case1_is_planned_from_rest_to_rest_and_only_the_torque_rate_fails(case1
     assert all(seconds > 0 for seconds in (timing.path_search, timing.simplify, timing.path_timing))
     figures = plan.stats.figures()
     assert set(figures) == {"path_time_s", "simplify_time_s", "smooth_time_s", "toppra_time_s", "validity_checks",
-                            "waypoints", "repair_rounds", "margin_m"}
+                            "waypoints", "repair_rounds", "margin_m", "path_searches"}
     assert (figures["validity_checks"], figures["toppra_time_s"]) == (path.validity_checks, timing.path_timing)
 
 
