@@ -120,11 +120,9 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
         return finish(problem, shaped.discretization.decode(w), "time_limit", method, started,
                       setup_time=graph_time, message="the time ran out in the guess, before the first solve",
                       timing=Timing(guess=guess_time, setup={"graph": graph_time}))
-    if near is not None and (samples := _near_left_out(problem, shaped.discretization,
-                                                       shaped.discretization.decode(w))) is not None:
-        near = np.vstack([near, samples])  # screened again by the guess before the solver is prepared
-        shaped, w = _reshaped(problem, options, near, shaped, w)
-        graph_time += shaped.graph_time
+    if near is not None and (wider := _widened(problem, options, shaped.discretization, near,
+                                               shaped.discretization.decode(w))):
+        (shaped, near), graph_time = wider, graph_time + wider[0].graph_time  # w stays: screening drops rows only
     made = prepare(shaped, graph_time)
     first_setup = made.setup_time or graph_time  # a cached build: the graphs built on the way
     budget = options.iteration_budget
@@ -134,9 +132,10 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
             and time.perf_counter() < deadline and refined.iterations < budget \
-            and (wider := _widened(problem, options.capped(budget - refined.iterations), made, near,
+            and (wider := _widened(problem, options.capped(budget - refined.iterations), made.discretization, near,
                                    refined.trajectory)):
-        (made, near), rebuilds = wider, rebuilds + 1
+        (shaped, near), rebuilds = wider, rebuilds + 1
+        made = prepare(shaped)
         restart = made.discretization.relifted(refined.result.w, Refinement())  # the checks back at their defaults
         refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, restart,
                                                     options.refinements, deadline,
@@ -192,16 +191,6 @@ def _shape(problem: Problem, options: SimultaneousOptions, near: np.ndarray | No
                  options.dynamics_options, near=near)
 
 
-def _reshaped(problem: Problem, options: SimultaneousOptions, near: np.ndarray, before: Shaped,
-              w: np.ndarray) -> tuple[Shaped, np.ndarray]:
-    """The shape screened by `near` instead of `before`'s, and the guess `w` of `before` as its decision vector:
-    the same where screening left the variables as they were (it only drops constraint rows), else re-encoded."""
-    shaped = _shape(problem, options, near)
-    if shaped.discretization.nlp.variables.size != w.size:
-        w = shaped.discretization.encode(before.discretization.decode(w))
-    return shaped, w
-
-
 def _lacking(problem: Problem, made: Build, near: np.ndarray | None) -> Callable[[Trajectory], bool] | None:
     """With screening (`near` given): whether a motion comes near rows `made` left out, which ends its refinement
     rounds so the plan rebuilds with them instead; None without screening."""
@@ -217,15 +206,15 @@ def _near_left_out(problem: Problem, discretization: Discretization, motion: Tra
     return samples if screening.missing(problem, discretization.constraints, samples) else None
 
 
-def _widened(problem: Problem, options: SimultaneousOptions, made: Build, near: np.ndarray,
-             motion: Trajectory) -> tuple[Build, np.ndarray] | None:
-    """The rebuild screened by `near` and samples of `motion` when `motion` comes near rows `made` left out, with
-    those configurations (K, n); None when it does not."""
-    samples = _near_left_out(problem, made.discretization, motion)
+def _widened(problem: Problem, options: SimultaneousOptions, discretization: Discretization, near: np.ndarray,
+             motion: Trajectory) -> tuple[Shaped, np.ndarray] | None:
+    """The shape screened by `near` and samples of `motion` when `motion` comes near rows `discretization` left out,
+    with those configurations (K, n); None when it does not. Its solver is not prepared yet (`prepare`)."""
+    samples = _near_left_out(problem, discretization, motion)
     if samples is None:
         return None
     near = np.vstack([near, samples])
-    return prepare(_shape(problem, options, near)), near
+    return _shape(problem, options, near), near
 
 
 def _continued(before: Refined, after: Refined) -> Refined:
