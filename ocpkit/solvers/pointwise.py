@@ -11,7 +11,7 @@ multipliers, or λ_f):
     ∂g/∂x = blockdiag(∂F/∂z(z_k)) A,    A = ∂Z/∂x
     ∇²ₓ(λ_f f + λᵀg) = Aᵀ blockdiag(∇²_z(λ_kᵀF)(z_k)) A + Σᵢ vᵢ ∇²ₓZᵢ,    v = blockdiag(∂F/∂z(z_k))ᵀ λ
 
-The last term appears only where Z is not linear in x (a torque with friction, a path-timing OCP's state). Inputs
+The last term appears only where Z is not linear in x (a torque with friction, a path-timing OCP's jerk). Inputs
 shared by several calls (the values at one point) are differentiated once. The other rows (collocation and
 interpolation defects, nearly linear) are differentiated by CasADi a few rows at a time, and the objective too
 when it is not a point call. The result equals CasADi's own derivatives (tests/solvers/test_pointwise.py).
@@ -26,7 +26,7 @@ S_k B_k A_k(p) and A_k(p)ᵀ H_k A_k(p); the objective, when it is a point call,
 marked `compiled` (the dynamics rows: their point function depends on the robot and the OCP only, so its C is
 the same for every problem of a robot) run their point derivatives compiled to C (ocpkit.solvers.compiled),
 CasADi's virtual machine where nothing compiles. Calls with inputs not linear in x (a torque with friction, a
-path-timing OCP's state) take the SX graph.
+path-timing OCP's jerk in its objective) take the SX graph.
 """
 
 from __future__ import annotations

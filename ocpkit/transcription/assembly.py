@@ -124,8 +124,12 @@ class Assembly:
         self.objective_call = PointCall(function, tuple(inputs), tuple(parameters), 0)
         return function(*inputs, *parameters)
 
-    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX | None) -> PointValues:
-        """Values at one point at time t where the controls' interpolant has the slope du/dσ = `du_ds`."""
+    def point(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX | None) -> PointValues | tuple[ca.SX, ...]:
+        """Values at one point at time t where the controls' interpolant has the slope du/dσ = `du_ds`; for an OCP
+        whose constraints read the node (`OCP.constraints_read_node`), (x, u, du/dσ, dt/dσ), which the constraints'
+        point Functions turn into the values."""
+        if self.ocp.constraints_read_node:
+            return x.x, x.u, du_ds, dt_ds
         return self._point(x, du_ds, dt_ds, t)
 
     def path(self, x: Node, slopes: Sequence[ca.SX], dt_ds: ca.SX, t: ca.SX | None, at_knot: bool = False) -> None:
@@ -145,21 +149,26 @@ class Assembly:
         for slope in slopes:
             self._rates(self.point(x, slope, dt_ds, t))
 
-    def _rates(self, values: PointValues) -> None:
+    def _rates(self, values: PointValues | tuple[ca.SX, ...]) -> None:
         for index, constraint in enumerate(self.constraints):
             if constraint.reads_rate:
                 self._constraint(index, values)
 
-    def _constraint(self, index: int, values: PointValues) -> None:
-        """Constraint `index`'s rows at one point, through one CasADi Function of a symbolic point made on first
-        use: the constraint's Python code runs once per NLP instead of once per point (the calls are inlined)."""
+    def _constraint(self, index: int, values: PointValues | tuple[ca.SX, ...]) -> None:
+        """Constraint `index`'s rows at one point (`point`'s values, or the node), through one CasADi Function of a
+        symbolic point made on first use: the constraint's Python code runs once per NLP instead of once per point
+        (the calls are inlined)."""
+        by_node = self.ocp.constraints_read_node
+        fields = values if by_node else _point_fields(values)
+        parameters = (*(self._ocp_parameters if by_node else ()), *_context_symbols(self.contexts[index]))
         if index not in self._point_rows:
-            point = type(values)(*_symbols_like(_point_fields(values)))
+            symbols = _symbols_like(fields)
+            point = self._point(Node(*symbols[:2]), *symbols[2:], None) if by_node else type(values)(*symbols)
             rows = self.constraints[index].evaluate(point, self.contexts[index])
-            inputs = [*_point_fields(point), *_context_symbols(self.contexts[index])]
-            self._point_rows[index] = ca.Function("point_rows", inputs, [rows.g]), rows.lower, rows.upper
+            function = ca.Function("point_rows", [*symbols, *parameters], [rows.g])
+            self._point_rows[index] = function, rows.lower, rows.upper
         function, lower, upper = self._point_rows[index]
-        self._call(function, _point_fields(values), _context_symbols(self.contexts[index]), lower, upper)
+        self._call(function, fields, parameters, lower, upper)
 
     def _call(self, function: ca.Function, inputs: tuple, parameters: tuple, lower: np.ndarray | float,
               upper: np.ndarray | float, compiled: bool = False) -> None:

@@ -65,6 +65,11 @@ class OCP(ABC):
     extrapolated_controls: bool = False
     """Whether a pseudospectral transcription fixes the controls at a knot it does not collocate (LGR's free end)
     by extrapolation; a robot's dynamics rows fix them there already."""
+    constraints_read_node: bool = False
+    """Whether the path constraints' point Functions take the node itself (x, u, du/dσ, dt/dσ) and form the point
+    values inside, instead of taking the values: for an OCP whose values are not linear in its node (a path
+    timing's q = p(s)), so the constraint rows stay point calls linear in w, differentiated once per Function
+    (ocpkit.solvers.pointwise) rather than through the whole NLP's graph. Its point values must not read t."""
 
     @property
     @abstractmethod
@@ -339,6 +344,7 @@ class PathTimingOCP(ChainOCP):
     controls = 1
     parts = (("s", 1), ("sd", 1), ("sdd", 1))
     ends = 3
+    constraints_read_node = True  # q = p(s): not linear in s
 
     def __init__(self, robot: Robot, path: PathSpline) -> None:
         super().__init__(robot)

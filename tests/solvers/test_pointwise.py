@@ -135,10 +135,15 @@ def test_without_a_compiler_the_graphs_are_used_with_a_warning(tmp_path, monkeyp
 
 
 def test_pointwise_derivatives_with_inputs_not_linear_in_w():
-    """The path-timing OCP's state p(s), p′(s)ṡ, ... enters every point call: the chain rule's second-order term."""
+    """The path-timing OCP's state p(s), p′(s)ṡ, ... is not linear in w: its constraint rows read the node (s, ṡ, s̈,
+    the slopes), mapped like a robot's, and its objective's jerk p′s⃛ + ... takes the chain rule's second-order
+    term."""
     dynamics = make_dynamics("casadi", CASE.robot)
     constraints = make_constraints(CASE, ("state-limits", "torque", "torque-rate"))
     discretization = TRANSCRIPTIONS.get("chebyshev")(knots=8).build(CASE, dynamics, constraints, _path_timing())
+    nlp = discretization.nlp
+    assert nlp.point_calls and all(_input_map(call, nlp) is not None for call in nlp.point_calls)
+    assert _input_map(nlp.objective_call, nlp) is None
     _assert_same_derivatives(discretization, CASE)
 
 
