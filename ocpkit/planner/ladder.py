@@ -36,7 +36,9 @@ line after the first OMPL rung, whose path starts clear of the obstacles.
 
 The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an OMPL rung on a hard problem
 (MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified
-plan returns at once; the budget is what a failure costs. A capped rung (one with an iteration cap) also gets at
+plan returns at once; the budget is what a failure costs. A rung's last solve is verified after the rung's time is
+up, so each rung is given the time left less the longest verification seen so far in the climb (on the Fetch one
+takes 1-2 s): the budget bounds the verifications too. A capped rung (one with an iteration cap) also gets at
 most RUNG_SHARE of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP)
 then ends by time, not after the whole budget, so the safety net and another rung still get their turn. A ladder
 that verifies nothing, where every OMPL rung found no path, ends `no_path`, with the configurations the last
@@ -212,7 +214,8 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     rung when its plan calls for one (on None once if the ladder is empty), until one that is not a safety net
     verifies or the `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than
     the last rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module
-    docstring). A rung may take the time left, a capped one at most RUNG_SHARE of `max_wall_time`; once a safety
+    docstring). A rung may take the time left, less the longest verification of the rungs before it (its last
+    solve's verification runs after its time is up), a capped one at most RUNG_SHARE of `max_wall_time`; once a safety
     net has verified, no rung starts with less than that share left. A safety net runs only where an OMPL rung of
     its seed found a path."""
     if not ladder:
@@ -221,8 +224,9 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     skipped: list[str] = []
     share = RUNG_SHARE * max_wall_time
 
-    def left() -> float:
-        return max_wall_time - sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
+    def left() -> float:  # less the longest verification so far: a rung's last one runs after its time is up
+        spent = sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
+        return max_wall_time - spent - max((r.verify for _, p in tried for r in p.stats.timing.rounds), default=0.0)
 
     def room() -> bool:  # time for a build as long as the last one (a rung that cannot build only overruns), and
         # with a certified plan in hand (a safety net's) for a whole share: a shorter rung is not worth the wait

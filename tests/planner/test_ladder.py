@@ -27,7 +27,7 @@ from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HIN
                                    finer_grid, ordered, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
-from ocpkit.result import Plan, PlanStats, RungRow
+from ocpkit.result import Plan, PlanStats, RungRow, SolveTiming, Timing
 from ocpkit.verify import Check, Verification
 
 CASE2 = ocpkit.load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -126,6 +126,16 @@ def test_every_rung_gets_the_time_left_and_none_starts_after_the_budget():
     result = climb(script, LADDER, 8.0)
     assert script.calls == [("a", 8.0), ("b", 2.5)]  # a's 5 s of computation and 0.5 s of set-up spent
     assert result.status == "infeasible" and result.method["rung"] == "a"
+
+
+def test_a_rung_is_given_the_time_left_less_the_longest_verification_so_far():
+    """A rung's last solve is verified after its time is up: the budget keeps room for that verification."""
+    rounds = (SolveTiming(2.0, 0.5, 10), SolveTiming(1.0, 1.5, 5))
+    a = fake("infeasible", seconds=5.0)
+    a = dataclasses.replace(a, stats=dataclasses.replace(a.stats, timing=Timing(rounds=rounds)))
+    script = Script({"a": a, "b": fake("iteration_limit", seconds=1.0), "c": fake("verified")})
+    climb(script, LADDER, 10.0)
+    assert script.calls == [("a", 10.0), ("b", 3.0), ("c", 1.5)]  # 10 − 5.5 s − 1.5 s; then 1.5 s less
 
 
 def test_a_capped_rung_takes_at_most_its_share_of_the_budget_and_one_stopped_by_it_is_tried_uncapped():
