@@ -37,8 +37,8 @@ line after the first OMPL rung, whose path starts clear of the obstacles.
 The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an OMPL rung on a hard problem
 (MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified
 plan returns at once; the budget is what a failure costs. A rung's last solve is verified after the rung's time is
-up, so each rung is given the time left less the longest verification seen so far in the climb (on the Fetch one
-takes 1-2 s): the budget bounds the verifications too. A capped rung (one with an iteration cap) also gets at
+up, so each rung is given the time left less the longest verification seen so far in the climb: the budget bounds
+the verifications too. A capped rung (one with an iteration cap) also gets at
 most RUNG_SHARE of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP)
 then ends by time, not after the whole budget, so the safety net and another rung still get their turn. A ladder
 that verifies nothing, where every OMPL rung found no path, ends `no_path`, with the configurations the last
