@@ -424,12 +424,15 @@ class PathTimingOCP(ChainOCP):
 
 def rigid_torque_rate(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, qddd: np.ndarray) -> np.ndarray:
     """d/dt rnea(q, q̇, q̈) = ∂τ/∂q q̇ + ∂τ/∂q̇ q̈ + M q⃛ (N m/s) at every row (m, n): shape (m, n)."""
-    data, rate = robot.model.createData(), np.empty(np.shape(q))
-    for k in range(len(rate)):
+    data, (m, n) = robot.model.createData(), np.shape(q)
+    dtau_dq, dtau_dv, mass = np.empty((m, n, n)), np.empty((m, n, n)), np.empty((m, n, n))
+    for k in range(m):  # the C++ calls only; the products below are batched
         pin.computeRNEADerivatives(robot.model, data, q[k], qd[k], qdd[k])
-        mass = np.triu(data.M) + np.triu(data.M, 1).T  # pinocchio fills the upper triangle
-        rate[k] = data.dtau_dq @ qd[k] + data.dtau_dv @ qdd[k] + mass @ qddd[k]
-    return rate
+        dtau_dq[k], dtau_dv[k], mass[k] = data.dtau_dq, data.dtau_dv, data.M
+    upper = np.triu(np.ones((n, n), dtype=bool))  # pinocchio fills M's upper triangle only
+    mass = np.where(upper, mass, np.swapaxes(mass, 1, 2))
+    return (np.einsum("kij,kj->ki", dtau_dq, qd) + np.einsum("kij,kj->ki", dtau_dv, qdd)
+            + np.einsum("kij,kj->ki", mass, qddd))
 
 
 def straight_line(problem: Problem) -> Trajectory:
