@@ -44,20 +44,18 @@ then ends by time, not after the whole budget, so the safety net and another run
 that verifies nothing, where every OMPL rung found no path, ends `no_path`, with the configurations the last
 search checked: where the obstacles leave no way through, that is the evidence, and no failed solve says more.
 
-The safety net (`Rung.safety_net`, after the first OMPL rung): where that rung found a path but its solve did not
+The safety nets (`Rung.safety_net`, one after each OMPL rung): where that rung found a path but its solve did not
 verify, ompl-topp3 times the same path (reused, not searched again: ocpkit.planner.ompl_seed) along its fixed
-geometry under every limit, a motion that usually verifies, slower than an optimal one. Its verified plan does not
-stop the ladder, which climbs on for a plan that is optimal in path and timing together; it is the answer only when
-no other rung verifies (anytime: the best certified plan found within the budget, its rung named). With that
-plan in hand the ladder climbs on only while a capped rung's share of the budget is left: a rung that could not
-have its share is not worth the wait for an answer already certified.
+geometry under every limit, a motion that usually verifies, slower than an optimal one. A verified net ends the
+climb like any verified rung, its rung named in the plan: the rungs after it seldom verify where the OMPL rung
+before them did not, and waiting for them costs the rest of the budget for a plan already certified.
 
 An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as that many iterations, at the pace
-of its iterations so far, would not end within the rung's time. Where an iteration is slow (a large NLP: the
-Fetch's thousands of self-collision rows) and the path search has taken much of the rung's share, the solve would
-end at its time limit anyway, most often unconverged: it gives that time to the safety net, which times the same
-path, instead. Most solves that converge do so within a hundred iterations (the first rung's cap); a solve
-whose iterations are fast enough never notices the pace.
+of its iterations so far, would not end within the rung's time. That many is about what a rung's solves take in
+all, its refinement rounds included, on a plan that verifies: a rung that could not do that much work in its time
+would end at its time limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
+of self-collision rows) it gives that time to the safety net, which times the same path, instead; a solve whose
+iterations are fast enough never notices the pace.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
@@ -88,8 +86,8 @@ OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
 OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.planner.ompl_seed.OMPL_PLANNERS)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
-PACE_ITERATIONS = 100  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
-RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take; a certified plan in hand ends the climb below it
+PACE_ITERATIONS = 150  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
+RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take
 
 
 @dataclass(frozen=True)
@@ -169,8 +167,10 @@ DEFAULT_LADDER: tuple[Rung, ...] = (
     Rung("ompl-0-topp3", guess="ompl", seed=0, safety_net=True),
     Rung("ompl-1-segments-3", guess="ompl", seed=1, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED,
          pace=PACE_ITERATIONS),
+    Rung("ompl-1-topp3", guess="ompl", seed=1, safety_net=True),
     Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED,
          pace=PACE_ITERATIONS),
+    Rung("ompl-2-topp3", guess="ompl", seed=2, safety_net=True),
     Rung("relaxed-first", relaxed=True, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("first-uncapped"),
 )
@@ -211,13 +211,12 @@ def rank(plan: Plan) -> tuple[int, float]:
 
 def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:
     """Plan with `attempt(rung, seconds it may take)` on each rung of `ladder` in turn, each followed by its `finer`
-    rung when its plan calls for one (on None once if the ladder is empty), until one that is not a safety net
-    verifies or the `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than
+    rung when its plan calls for one (on None once if the ladder is empty), until one verifies or the
+    `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than
     the last rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module
     docstring). A rung may take the time left, less the longest verification of the rungs before it (its last
-    solve's verification runs after its time is up), a capped one at most RUNG_SHARE of `max_wall_time`; once a safety
-    net has verified, no rung starts with less than that share left. A safety net runs only where an OMPL rung of
-    its seed found a path."""
+    solve's verification runs after its time is up), a capped one at most RUNG_SHARE of `max_wall_time`. A safety
+    net runs only where an OMPL rung of its seed found a path."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
@@ -228,10 +227,8 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
         spent = sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
         return max_wall_time - spent - max((r.verify for _, p in tried for r in p.stats.timing.rounds), default=0.0)
 
-    def room() -> bool:  # time for a build as long as the last one (a rung that cannot build only overruns), and
-        # with a certified plan in hand (a safety net's) for a whole share: a shorter rung is not worth the wait
-        certified = any(p.ok for _, p in tried)
-        return not tried or left() > max(tried[-1][1].stats.setup_time, share if certified else 0.0)
+    def room() -> bool:  # time for a build as long as the last one: a rung that cannot build only overruns
+        return not tried or left() > tried[-1][1].stats.setup_time
 
     def allowed(rung: Rung) -> float:  # the seconds `rung` may take
         return max(min(left(), share) if rung.max_iterations is not None else left(), 0.0)
@@ -245,7 +242,7 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
         tried.append((rung, attempt(rung, allowed(rung))))
         if (next_rung := finer(*tried[-1])) is not None and room():
             tried.append((next_rung, attempt(next_rung, allowed(next_rung))))
-        if tried[-1][1].ok and not tried[-1][0].safety_net:
+        if tried[-1][1].ok:
             break
     return _combined(tried, skipped)
 
