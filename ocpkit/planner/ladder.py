@@ -48,7 +48,11 @@ The safety nets (`Rung.safety_net`, one after each OMPL rung): where that rung f
 verify, ompl-topp3 times the same path (reused, not searched again: ocpkit.planner.ompl_seed) along its fixed
 geometry under every limit, a motion that usually verifies, slower than an optimal one. A verified net ends the
 climb like any verified rung, its rung named in the plan: the rungs after it seldom verify where the OMPL rung
-before them did not, and waiting for them costs the rest of the budget for a plan already certified.
+before them did not, and waiting for them costs the rest of the budget for a plan already certified. A net times
+its path on NET_SEGMENTS pseudospectral segments of NET_KNOTS intervals, not on the call's grid: along a path
+with several sharp turns the time-optimal s(t) slows down before each, which one polynomial of degree 12 over
+the whole motion cannot follow, so its timing ended infeasible with t_f at its upper bound where the TOPP-RA
+profile of the same path was well within it.
 
 An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as that many iterations, at the pace
 of its iterations so far, would not end within the rung's time. That many is about what a rung's solves take in
@@ -88,6 +92,7 @@ OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.plann
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 PACE_ITERATIONS = 150  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
 RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take
+NET_KNOTS, NET_SEGMENTS = 8, 4  # a safety net's timing grid: 4 pseudospectral segments of 8 intervals (docstring)
 
 
 @dataclass(frozen=True)
@@ -101,8 +106,8 @@ class Rung:
     instead of `guess`, and `pace`: the rung's first solve stops as soon as that many iterations at its pace
     would not end within the rung's time (PreparedSolver.solve). An "ompl" rung's path search stops after
     OMPL_CHECKS configurations checked or when the rung's time is up. A `safety_net` rung (guess "ompl") plans
-    with ompl-topp3 instead, on the OMPL path of its `seed` (module docstring); the simultaneous planner runs it,
-    not `apply`."""
+    with ompl-topp3 instead, on the OMPL path of its `seed` and on its own grid (`knots`, `segments`: module
+    docstring); the simultaneous planner runs it with the options `apply` gives."""
 
     name: str
     guess: str | None = None
@@ -164,13 +169,13 @@ DEFAULT_LADDER: tuple[Rung, ...] = (
     Rung("first", max_iterations=FIRST_ITERATIONS),
     Rung("ompl-0-segments-3", guess="ompl", seed=0, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED,
          pace=PACE_ITERATIONS),
-    Rung("ompl-0-topp3", guess="ompl", seed=0, safety_net=True),
+    Rung("ompl-0-topp3", guess="ompl", seed=0, knots=NET_KNOTS, segments=NET_SEGMENTS, safety_net=True),
     Rung("ompl-1-segments-3", guess="ompl", seed=1, knots=6, segments=3, max_iterations=MAX_ITERATIONS_CAPPED,
          pace=PACE_ITERATIONS),
-    Rung("ompl-1-topp3", guess="ompl", seed=1, safety_net=True),
+    Rung("ompl-1-topp3", guess="ompl", seed=1, knots=NET_KNOTS, segments=NET_SEGMENTS, safety_net=True),
     Rung("ompl-2-knots-16", guess="ompl", seed=2, knots=16, max_iterations=MAX_ITERATIONS_CAPPED,
          pace=PACE_ITERATIONS),
-    Rung("ompl-2-topp3", guess="ompl", seed=2, safety_net=True),
+    Rung("ompl-2-topp3", guess="ompl", seed=2, knots=NET_KNOTS, segments=NET_SEGMENTS, safety_net=True),
     Rung("relaxed-first", relaxed=True, max_iterations=MAX_ITERATIONS_CAPPED),
     Rung("first-uncapped"),
 )

@@ -72,7 +72,7 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
 
     def attempt(rung: Rung | None, left: float) -> Plan:
         if rung is not None and rung.safety_net:
-            return _timed_path(problem, options, rung.seed or 0, left)
+            return _timed_path(problem, rung.apply(options, left), rung.seed or 0, left)
         return _single_shot(problem, options if rung is None else rung.apply(options, left), left)
 
     return climb(attempt, ordered(options.fallbacks, _buried_line(problem, options)), options.max_wall_time)
@@ -154,7 +154,8 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
 def _timed_path(problem: Problem, options: SimultaneousOptions, seed: int, max_wall_time: float) -> Plan:
     """The ompl-topp3 planner's plan (registry PLANNERS) on the path an OMPL rung of `seed` searched for (the same
     search options, so the path found is reused: ocpkit.planner.ompl_seed.ompl_path), its timing solved with the
-    call's transcription, grid, dynamics and solver within `max_wall_time` (s)."""
+    transcription, grid, dynamics and solver of `options` (the call's with the net rung's grid) within
+    `max_wall_time` (s)."""
     return PLANNERS.get("ompl-topp3")(
         problem, transcription=options.transcription, knots=options.knots, dynamics=options.dynamics,
         solver=options.solver, refinements=options.refinements, transcription_options=options.transcription_options,

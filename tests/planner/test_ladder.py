@@ -22,9 +22,9 @@ from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES
 from ocpkit.planner.guesses import ompl_guess
-from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NO_PATH_HINT, OMPL_CHECKS, OMPL_PLANNER,
-                                   OMPL_RESOLUTION, PACE_ITERATIONS, RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer,
-                                   finer_grid, ordered, rank)
+from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NET_KNOTS, NET_SEGMENTS, NO_PATH_HINT,
+                                   OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, PACE_ITERATIONS, RUNG_SHARE, SINGLE_SHOT,
+                                   Rung, climb, finer, finer_grid, ordered, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow, SolveTiming, Timing
@@ -259,6 +259,20 @@ def test_a_straight_line_with_a_sphere_centre_inside_an_obstacle_plans_the_ompl_
     plan_simultaneous(blocked, knots=6, guess="ompl")  # a guess of its own: the ladder as given
     plan_simultaneous(CASE2, knots=6)  # its line is clear
     assert seen[0][0].guess == "ompl" and seen[1] == DEFAULT_LADDER and seen[2] == DEFAULT_LADDER
+
+
+def test_a_safety_net_times_its_path_on_its_own_grid_with_the_calls_other_options(monkeypatch):
+    attempts, timed = [], []
+    monkeypatch.setattr("ocpkit.planner.simultaneous.climb", lambda attempt, ladder, budget: attempts.append(attempt))
+    monkeypatch.setattr("ocpkit.planner.simultaneous._timed_path",
+                        lambda problem, options, seed, left: timed.append((options, seed, left)))
+    plan_simultaneous(CASE2, knots=6, solver_options={"tol": 1e-7})
+    net = next(rung for rung in DEFAULT_LADDER if rung.safety_net)
+    attempts[0](net, 5.0)
+    options, seed, left = timed[0]
+    assert (options.knots, options.transcription_options["segments"]) == (NET_KNOTS, NET_SEGMENTS)
+    assert options.solver_options == {"tol": 1e-7} and (seed, left) == (net.seed, 5.0)
+    assert all((r.knots, r.segments) == (NET_KNOTS, NET_SEGMENTS) for r in DEFAULT_LADDER if r.safety_net)
 
 
 def test_a_plan_that_verifies_on_the_first_rung_reports_one_rung():
