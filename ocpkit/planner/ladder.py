@@ -55,9 +55,10 @@ the whole motion cannot follow, so its timing ended infeasible with t_f at its u
 profile of the same path was well within it.
 
 An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as that many iterations, at the pace
-of its iterations so far, would not end within the rung's time. That many is about what a rung's solves take in
-all, its refinement rounds included, on a plan that verifies: a rung that could not do that much work in its time
-would end at its time limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
+of its iterations so far, would not end within the rung's time. That many is what a rung's solves may take in
+all, its refinement rounds included, on a plan that verifies (most take far fewer; the large NLPs of the Fetch
+ran past 150 iterations without verifying): a rung that could not do that much work in its time would end at its
+time limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
 of self-collision rows) it gives that time to the safety net, which times the same path, instead; a solve whose
 iterations are fast enough never notices the pace.
 
@@ -90,7 +91,7 @@ OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
 OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.planner.ompl_seed.OMPL_PLANNERS)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
-PACE_ITERATIONS = 150  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
+PACE_ITERATIONS = 250  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
 RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take
 NET_KNOTS, NET_SEGMENTS = 8, 4  # a safety net's timing grid: 4 pseudospectral segments of 8 intervals (docstring)
 
