@@ -50,14 +50,14 @@ geometry under every limit, a motion that usually verifies, slower than an optim
 climb like any verified rung, its rung named in the plan: the rungs after it seldom verify where the OMPL rung
 before them did not, and waiting for them costs the rest of the budget for a plan already certified. A net times
 its path on NET_SEGMENTS pseudospectral segments of NET_KNOTS intervals, not on the call's grid: along a path
-with several sharp turns the time-optimal s(t) slows down before each, which one polynomial of degree 12 over
-the whole motion cannot follow, so its timing ended infeasible with t_f at its upper bound where the TOPP-RA
-profile of the same path was well within it.
+with several sharp turns the time-optimal s(t) slows down before each, which one polynomial over the whole
+motion (the default 12 knots) cannot follow: on that grid such a timing can end infeasible with t_f at its upper
+bound where TOPP-RA times the same path well within it.
 
 An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as that many iterations, at the pace
 of its iterations so far, would not end within the rung's time. That many is what a rung's solves may take in
-all, its refinement rounds included, on a plan that verifies (most take far fewer; the large NLPs of the Fetch
-ran past 150 iterations without verifying): a rung that could not do that much work in its time would end at its
+all, its refinement rounds included, on a plan that verifies (most take far fewer; a large NLP, the Fetch's,
+runs past 150 without verifying): a rung that could not do that much work in its time would end at its
 time limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
 of self-collision rows) it gives that time to the safety net, which times the same path, instead; a solve whose
 iterations are fast enough never notices the pace.
