@@ -71,9 +71,10 @@ def plan_simultaneous(problem: Problem, transcription: str = "chebyshev", knots:
         guess_options=guess_options or {}, fallbacks=fallbacks, screen=screen)
 
     def attempt(rung: Rung | None, left: float) -> Plan:
+        applied = options if rung is None else rung.apply(options, left)
         if rung is not None and rung.safety_net:
-            return _timed_path(problem, rung.apply(options, left), rung.seed or 0, left)
-        return _single_shot(problem, options if rung is None else rung.apply(options, left), left)
+            return _timed_path(problem, applied, rung.seed or 0, left)
+        return _single_shot(problem, applied, left)
 
     return climb(attempt, ordered(options.fallbacks, _buried_line(problem, options)), options.max_wall_time)
 
