@@ -96,7 +96,9 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     build) ends the plan as `time_limit` with the guess's motion, without the rebuild or solve that could only
     overrun. With screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight
     line. A guess that comes near rows left out is screened again, with them added, before the solver is prepared
-    (a solver's preparation is most of a build); an unverified solution that does is solved again on a rebuild.
+    (a solver's preparation is most of a build); an unverified solution that does is solved again on a rebuild,
+    unless its solve was stopped by time: at the deadline, or by its pace, which hands the rung's time on
+    (ocpkit.planner.ladder), and a rebuild with more rows would only iterate more slowly.
     The builds before the first solve are the plan's set-up, a rebuild after it is computation."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
@@ -132,7 +134,7 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
                             options.pace)
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
-            and time.perf_counter() < deadline and refined.iterations < budget \
+            and refined.result.status != SolverStatus.TIME_LIMIT and refined.iterations < budget \
             and (wider := _widened(problem, options.capped(budget - refined.iterations), made.discretization, near,
                                    refined.trajectory)):
         (shaped, near), rebuilds = wider, rebuilds + 1
