@@ -7,8 +7,11 @@ workspace's six faces a large box (`_world_shapes`). The checked pairs are the r
 each sphere against each obstacle and face. It is the path search's test (ocpkit.planner.ompl_seed); `verify`
 keeps the NumPy reference.
 
-A broad phase (coal's dynamic AABB tree, through pinocchio's broad-phase manager) hands the narrow phase only the
-pairs whose bounding boxes overlap. For that to be exact, every robot sphere is grown by i = max(margin, 0) and
+A broad phase (through pinocchio's broad-phase manager) hands the narrow phase only the pairs whose bounding boxes
+overlap. It is coal's naive manager, which tests every two boxes of a configuration: for the hundred-odd spheres
+and few obstacles of a robot in a scene that is faster than refitting and walking coal's dynamic AABB tree
+(docs/design-notes.md, 2026-12-04). For the broad phase to be exact, every robot sphere is grown by
+i = max(margin, 0) and
 each pair's security margin (coal counts a pair as colliding when its distance is below it) takes the rest:
 margin − i for a sphere against an obstacle, margin − 2i for two spheres. Both are ≤ 0, so a pair that counts as
 colliding overlaps its grown boxes, and its clearance is below `margin` exactly when coal says it collides.
@@ -44,12 +47,13 @@ class CoalCheck:
         for sphere in spheres:
             for body in fixed:
                 model.addCollisionPair(pin.CollisionPair(sphere, body))
-        self.pool = pin.BroadPhaseManagerPool_DynamicAABBTreeCollisionManager(robot.model, model, 1)
+        self.geometry, self.geometry_data = model, pin.GeometryData(model)
         grown_pair = [2 * grown if pair.second < len(spheres) else grown for pair in model.collisionPairs]
-        for data in self.pool.getGeometryDatas():
-            for request, taken in zip(data.collisionRequests, grown_pair):
-                request.security_margin = margin - taken
-                request.enable_contact = False
+        for request, taken in zip(self.geometry_data.collisionRequests, grown_pair):
+            request.security_margin = margin - taken
+            request.enable_contact = False
+        self.model, self.data = robot.model, robot.model.createData()
+        self.manager = pin.BroadPhaseManager_NaiveCollisionManager(self.model, self.geometry, self.geometry_data)
 
     def free(self, q: np.ndarray) -> np.ndarray:
         """Whether each configuration of q (K, n) keeps the margin everywhere: shape (K,), bool."""
@@ -64,8 +68,13 @@ class CoalCheck:
     def _collides(self, q: np.ndarray, stop_at_first: bool) -> np.ndarray:
         """Per configuration of q (K, n), whether some pair is within the margin (bool (K,)); with `stop_at_first`
         the configurations after the first such one are left False."""
-        columns = np.asfortranarray(np.atleast_2d(q).T)  # pinocchio takes configurations as columns
-        return np.asarray(pin.computeCollisionsInParallel(1, self.pool, columns, True, stop_at_first), dtype=bool)
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        hits = np.zeros(len(q), dtype=bool)
+        for k, configuration in enumerate(q):  # each call stops at its first colliding pair
+            hits[k] = pin.computeCollisions(self.model, self.data, self.manager, configuration, True)
+            if hits[k] and stop_at_first:
+                break
+        return hits
 
 
 def _world_shapes(scene: Scene) -> list[tuple[str, pin.SE3, coal.CollisionGeometry]]:
