@@ -11,10 +11,10 @@ A broad phase (through pinocchio's broad-phase manager) hands the narrow phase o
 overlap. It is coal's naive manager, which tests every two boxes of a configuration: for the hundred-odd spheres
 and few obstacles of a robot in a scene that is faster than refitting and walking coal's dynamic AABB tree
 (docs/design-notes.md, 2026-12-04). For the broad phase to be exact, every robot sphere is grown by
-i = max(margin, 0) and
-each pair's security margin (coal counts a pair as colliding when its distance is below it) takes the rest:
-margin − i for a sphere against an obstacle, margin − 2i for two spheres. Both are ≤ 0, so a pair that counts as
-colliding overlaps its grown boxes, and its clearance is below `margin` exactly when coal says it collides.
+i = max(margin, 0) and each pair's security margin (coal counts a pair as colliding when its distance is below it)
+takes the rest: margin − i for a sphere against an obstacle, margin − 2i for two spheres. Both are ≤ 0, so a pair
+that counts as colliding overlaps its grown boxes, and its clearance is below `margin` exactly when coal says it
+collides.
 """
 
 from __future__ import annotations
@@ -81,7 +81,8 @@ def _world_shapes(scene: Scene) -> list[tuple[str, pin.SE3, coal.CollisionGeomet
     """(name, pose in the world, coal shape) of every obstacle and, with a workspace, of the region beyond each of
     its faces: a cube of edge SLAB against the face, centred on the workspace's centre across it, the same as the
     half-space for every sphere within SLAB / 2 of that centre, which is every sphere a robot can reach. (coal's
-    Halfspace has an unbounded box, which its AABB tree misses.)"""
+    Halfspace has an unbounded bounding box, which coal's dynamic AABB tree missed; a cube is safe in any broad
+    phase.)"""
     shapes = [("sphere", pin.SE3(np.eye(3), c), coal.Sphere(float(r)))
               for c, r in zip(scene.obstacle_centers, scene.obstacle_radii)]
     shapes += [("box", pin.SE3(rotation, c), coal.Box(*map(float, size)))
