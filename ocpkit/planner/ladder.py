@@ -59,9 +59,9 @@ of its iterations so far, would not end within the rung's time. That many is wha
 all, its refinement rounds included, on a plan that verifies (most take far fewer; a large NLP, the Fetch's,
 runs past 150 without verifying): a rung that could not do that much work in its time would end at its
 time limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
-of self-collision rows) it gives that time to the safety net, which times the same path, instead (a screening
-rebuild's solve keeps the pace too: ocpkit.planner.simultaneous); a solve whose iterations are fast enough never
-notices the pace.
+of self-collision rows) it gives that time to the safety net, which times the same path, instead (no screening
+rebuild follows a solve stopped by time: ocpkit.planner.simultaneous); a solve whose iterations are fast enough
+never notices the pace.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same

@@ -96,10 +96,9 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     build) ends the plan as `time_limit` with the guess's motion, without the rebuild or solve that could only
     overrun. With screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight
     line. A guess that comes near rows left out is screened again, with them added, before the solver is prepared
-    (a solver's preparation is most of a build); an unverified solution that does is solved again on a rebuild.
-    A rebuild's solve keeps the rung's pace as its first solve does (ocpkit.planner.ladder), and no further
-    rebuild follows one stopped by time: the pace that stopped the first solve is then confirmed on the rows the
-    motion needs, and the rung hands its time on.
+    (a solver's preparation is most of a build); an unverified solution that does is solved again on a rebuild,
+    unless its solve was stopped by time: at the deadline, or by its pace, which hands the rung's time on
+    (ocpkit.planner.ladder), and a rebuild with more rows would only iterate more slowly.
     The builds before the first solve are the plan's set-up, a rebuild after it is computation."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
@@ -132,11 +131,10 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     budget = options.iteration_budget
     refined = solve_refined(made.discretization, made.solver, problem, w, options.refinements, deadline,
                             RELAXED if options.relaxed else None, budget, _lacking(problem, made, near),
-                            pace=options.pace)
+                            options.pace)
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
-            and time.perf_counter() < deadline and refined.iterations < budget \
-            and not (rebuilds and refined.result.status == SolverStatus.TIME_LIMIT) \
+            and refined.result.status != SolverStatus.TIME_LIMIT and refined.iterations < budget \
             and (wider := _widened(problem, options.capped(budget - refined.iterations), made.discretization, near,
                                    refined.trajectory)):
         (shaped, near), rebuilds = wider, rebuilds + 1
@@ -145,7 +143,7 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
         refined = _continued(refined, solve_refined(made.discretization, made.solver, problem, restart,
                                                     options.refinements, deadline,
                                                     iteration_budget=budget - refined.iterations,
-                                                    lacking=_lacking(problem, made, near), pace=options.pace))
+                                                    lacking=_lacking(problem, made, near)))
     result = refined.result
     stopped = None if result.status == SolverStatus.CONVERGED else result.status.value
     timing = Timing(guess=guess_time, setup=made.setup_parts, rounds=refined.timing)

@@ -13,8 +13,8 @@ from ocpkit.formats.scenario import load_scenario
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
 from ocpkit.planner.build_cache import clear_builds
 from ocpkit.planner.options import SimultaneousOptions
-from ocpkit.planner.screening import (CROWDED_DISTANCE, CROWDED_ROWS, MAX_REBUILDS, SCREEN_DISTANCE, line_samples,
-                                     missing, screenable_rows, screened, worth_screening)
+from ocpkit.planner.screening import (CROWDED_DISTANCE, CROWDED_ROWS, SCREEN_DISTANCE, line_samples, missing,
+                                     screenable_rows, screened, worth_screening)
 from ocpkit.planner.simultaneous import END_CHECK_CLEARANCE, _checked_near_the_ends, plan_simultaneous
 from ocpkit.solvers import SolverStatus
 from ocpkit.transcription.pseudospectral import long_interval_midpoints
@@ -125,28 +125,25 @@ def test_a_guess_near_left_out_rows_is_screened_again_before_the_solver_is_prepa
     assert plan.stats.setup_time == pytest.approx(setup["graph"] + setup["solver"] + setup["compile"])
 
 
-@pytest.mark.parametrize("status, prepared", [(SolverStatus.ITERATION_LIMIT, 1 + MAX_REBUILDS),
-                                              (SolverStatus.TIME_LIMIT, 2)])
-def test_a_rebuilds_solve_keeps_the_pace_and_one_stopped_by_time_is_not_rebuilt_again(monkeypatch, status,
-                                                                                      prepared):
-    """An unverified motion near left-out rows is solved again on a rebuild, at the rung's pace; once a rebuild's
-    solve too is stopped by time, the rung hands its time on."""
+@pytest.mark.parametrize("status, prepared", [(SolverStatus.ITERATION_LIMIT, 2), (SolverStatus.TIME_LIMIT, 1)])
+def test_an_unverified_solve_near_left_out_rows_is_rebuilt_unless_it_was_stopped_by_time(monkeypatch, status,
+                                                                                         prepared):
+    """A solve stopped by its pace hands the rung's time on: a rebuild with more rows would only iterate slower."""
     import ocpkit.planner.simultaneous as simultaneous
 
-    steps, paces, real_prepare, real_solve = [], [], simultaneous.prepare, simultaneous.solve_refined
+    steps, real_prepare, real_solve = [], simultaneous.prepare, simultaneous.solve_refined
     monkeypatch.setattr(simultaneous, "prepare", lambda *a, **k: steps.append("prepare") or real_prepare(*a, **k))
     monkeypatch.setattr(simultaneous, "_widened", lambda problem, options, discretization, near, motion:
-                        None if not steps else  # after the first solve: always more rows to add
-                        (simultaneous._shape(problem, options, near + 0.01 * len(steps)), near))
+                        None if steps.count("prepare") != 1 else  # once, after the first solve
+                        (simultaneous._shape(problem, options, np.vstack([near, line_samples(problem) + 0.05])),
+                         near))
 
-    def stopped(*args, pace=None, **kwargs):
-        paces.append(pace)
-        refined = real_solve(*args, pace=pace, **kwargs)
+    def stopped(*args, **kwargs):
+        refined = real_solve(*args, **kwargs)
         return dataclasses.replace(refined, result=dataclasses.replace(refined.result, status=status))
 
     monkeypatch.setattr(simultaneous, "solve_refined", stopped)
     clear_builds()
-    options = dataclasses.replace(PLAN_OPTIONS, knots=6, refinements=0, solver_options={"max_iterations": 2},
-                                  screen=True, pace=250)
-    plan = simultaneous._single_shot(PANDA, options, 60.0)
-    assert not plan.ok and steps.count("prepare") == prepared and paces == [250] * prepared
+    plan = plan_simultaneous(PANDA, fallbacks=(), screen=True, knots=6, refinements=0,
+                             solver_options={"max_iterations": 2})
+    assert not plan.ok and steps.count("prepare") == prepared
