@@ -134,7 +134,8 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
                             options.pace)
     rebuilds = 0
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
-            and refined.result.status != SolverStatus.TIME_LIMIT and refined.iterations < budget \
+            and time.perf_counter() < deadline and refined.result.status != SolverStatus.TIME_LIMIT \
+            and refined.iterations < budget \
             and (wider := _widened(problem, options.capped(budget - refined.iterations), made.discretization, near,
                                    refined.trajectory)):
         (shaped, near), rebuilds = wider, rebuilds + 1
