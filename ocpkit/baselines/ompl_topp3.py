@@ -44,8 +44,8 @@ from ocpkit.verify import GEOMETRY_CHECKS, SCALED_LIMITS
 TOPP3_HINTS = Hints(
     stopped={"no_path": NO_PATH_HINT,
              "infeasible": "the timing is locally infeasible along this path: give it more segments "
-                           "(transcription_options segments; the ladder's nets use 4 of 8 intervals) or try another "
-                           "seed (another path)",
+                           "(transcription_options segments; the ladder's nets use 4 segments of 8 intervals) or try "
+                           "another seed (another path)",
              "iteration_limit": "the timing solve reached its iteration limit: raise max_iterations "
                                 "(solver_options) or try another seed (another path)",
              "time_limit": "the timing solve reached max_wall_time: raise it"},

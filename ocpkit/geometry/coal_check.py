@@ -47,7 +47,7 @@ class CoalCheck:
         for sphere in spheres:
             for body in fixed:
                 model.addCollisionPair(pin.CollisionPair(sphere, body))
-        self.geometry, self.geometry_data = model, pin.GeometryData(model)
+        self.geometry, self.geometry_data = model, pin.GeometryData(model)  # kept: the manager points to them
         grown_pair = [2 * grown if pair.second < len(spheres) else grown for pair in model.collisionPairs]
         for request, taken in zip(self.geometry_data.collisionRequests, grown_pair):
             request.security_margin = margin - taken

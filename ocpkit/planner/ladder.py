@@ -56,9 +56,9 @@ bound where TOPP-RA times the same path well within it.
 
 An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as that many iterations, at the pace
 of its iterations so far, would not end within the rung's time. That many is what a rung's solves may take in
-all, its refinement rounds included, on a plan that verifies (most take far fewer; a large NLP, the Fetch's,
-runs past 150 without verifying): a rung that could not do that much work in its time would end at its
-time limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
+all, its refinement rounds included, on a plan that verifies (most take far fewer; a large NLP, the Fetch's, can
+run that many without verifying): a rung that could not do that much work in its time would end at its time
+limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
 of self-collision rows) it gives that time to the safety net, which times the same path, instead (no screening
 rebuild follows a solve stopped by time: ocpkit.planner.simultaneous); a solve whose iterations are fast enough
 never notices the pace.
