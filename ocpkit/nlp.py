@@ -93,8 +93,6 @@ class PointCall:
     compiled: bool = False
     """Whether its derivatives are worth compiling to C: set for a function that depends on the robot and the OCP
     only (the dynamics rows), whose C is then the same for every problem of the robot (ocpkit.solvers.compiled)."""
-    costly_curvature: bool = False
-    """Whether its rows' second derivatives may be left out of a cheaper Hessian (Constraint.costly_curvature)."""
 
 
 @dataclass(frozen=True)

@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import casadi as ca
 import numpy as np
 
-from ocpkit.nlp import NLP, Layout, PointCall
+from ocpkit.nlp import NLP, Layout
 
 DISK = 1.532
 """The Rosenbrock disk's bound on w0² + w1²: active at the optimum."""
@@ -39,15 +37,6 @@ def rosenbrock_disk(exact_hessian: bool = True, disk: float = DISK) -> NLP:
     f = (p[0] - w[0]) ** 2 + 100 * (w[1] - w[0] ** 2) ** 2 + (w[2] - 1) ** 2
     g = ca.vertcat(w[0] ** 2 + w[1] ** 2, w[0] + w[1] - p[1])
     return toy_nlp(variables, f, g, [-np.inf, 0.0], [disk, 0.0], parameters, exact_hessian)
-
-
-def rosenbrock_costly_disk() -> NLP:
-    """`rosenbrock_disk` whose disk row is a point call marked `costly_curvature` (as MBM's grouped collision
-    rows are): IPOPT starts it on the Hessian without the disk's curvature."""
-    nlp = rosenbrock_disk()
-    z = ca.SX.sym("z", 2)
-    disk = ca.Function("disk", [z], [ca.dot(z, z)])
-    return dataclasses.replace(nlp, point_calls=(PointCall(disk, (nlp.x[:2],), (), 0, costly_curvature=True),))
 
 
 def optimum(disk: float = DISK) -> np.ndarray:

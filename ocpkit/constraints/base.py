@@ -102,12 +102,6 @@ class Constraint(ABC):
     screened_at: float = 0.0
     """The distance (its own unit) `screened` kept its rows within; 0 when it was not screened."""
 
-    @property
-    def costly_curvature(self) -> bool:
-        """Whether these rows' second derivatives cost most of an NLP iteration, so that a solver may leave them
-        out of its first iterations (ocpkit.solvers.casadi_nlpsol.Ipopt); False by default."""
-        return False
-
     def screened(self, problem: Problem, near: np.ndarray, distance: float) -> Constraint:
         """This constraint for `problem` without the rows that stay inactive by more than `distance` (its own unit)
         at every configuration of `near` (K, n) (ocpkit.planner.screening); itself when it has nothing to leave out."""

@@ -90,12 +90,6 @@ class SphereCollision(Constraint):
         """Collision rows per point."""
         return int(self.pair_mask.sum() + self.obstacle_mask.sum() + len(self._face_rows()[0]))
 
-    @property
-    def costly_curvature(self) -> bool:
-        """Grouped rows (many terms per point): their Hessian, through the sphere centres' kinematics, is most of
-        an IPOPT iteration's evaluation on such a robot."""
-        return self.grouped
-
     def _face_rows(self) -> tuple[np.ndarray, np.ndarray]:
         """(sphere, axis) of each workspace row: one per axis with a reachable face."""
         return np.nonzero(self.face_mask[:, :3] | self.face_mask[:, 3:])

@@ -20,13 +20,10 @@ unconverged solve that overran its limit is reported as `time_limit` after the f
 from __future__ import annotations
 
 import contextlib
-import dataclasses
-import functools
 import os
 import sys
 import time
 from abc import abstractmethod
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import casadi as ca
@@ -75,16 +72,6 @@ DIVERGED = 1.0
 """An iterate this far beyond a bound (times the bound's width, at least 1) has diverged."""
 
 
-CHEAP_HESSIAN_ITERATIONS = 20
-"""IPOPT iterations on the cheaper Hessian (Ipopt) before a solve that has not converged goes on with the exact one."""
-
-CHEAP_HESSIAN_ACCEPTABLE = {"acceptable_tol": 1e20, "acceptable_constr_viol_tol": 1e-5,
-                            "acceptable_compl_inf_tol": 1e-4, "acceptable_obj_change_tol": 1e-5, "acceptable_iter": 5}
-"""IPOPT's options for stopping a solve on the cheaper Hessian as `Solved_To_Acceptable_Level`: five iterations in a
-row with the objective changing by less than 10⁻⁵ (relative), the constraints met to 10⁻⁵ and complementarity to
-10⁻⁴, whatever the dual residual: an inexact Hessian has it fall only linearly once the iterate is at the
-solution."""
-
 PACE_FROM = 3
 """Callback calls (the start and the iterations after it) before a pace is judged: the first ones carry the
 solve's own start-up."""
@@ -102,12 +89,11 @@ class _Deadline(ca.Callback):
         self.arm(np.inf, np.full(n_w, -np.inf), np.full(n_w, np.inf))
         self.construct("deadline", {})
 
-    def arm(self, deadline: float, lbx: np.ndarray, ubx: np.ndarray, pace: int | None = None,
-            cap: int | None = None) -> None:
+    def arm(self, deadline: float, lbx: np.ndarray, ubx: np.ndarray, pace: int | None = None) -> None:
         """Watch one solve, from now: stop at `deadline` (time.perf_counter s), as soon as `pace` iterations at the
-        pace so far would end after it, when the iterate has diverged from [lbx, ubx] (n_w,) (module
-        docstring), or after `cap` iterations."""
-        self.deadline, self.reason, self.pace, self.cap = deadline, "", pace, cap
+        pace so far would end after it, or when the iterate has diverged from [lbx, ubx] (n_w,) (module
+        docstring)."""
+        self.deadline, self.reason, self.pace = deadline, "", pace
         self.started, self.iterations = time.perf_counter(), 0
         slack = DIVERGED * bound_slack(lbx, ubx) / BOUND_TOLERANCE
         self.lower, self.upper = lbx - slack, ubx + slack
@@ -139,8 +125,6 @@ class _Deadline(ca.Callback):
                 self.reason = "bounds"
             elif now > self.deadline:
                 self.reason = "deadline"
-            elif self.cap is not None and self.iterations > self.cap:  # the first call is iteration 0's
-                self.reason = "iterations"
             elif self.pace and self.iterations >= PACE_FROM and \
                     self.started + self.pace * (now - self.started) / self.iterations > self.deadline:
                 self.reason = "pace"
@@ -150,75 +134,46 @@ class _Deadline(ca.Callback):
 
 
 _STOPPED = {"deadline": SolverStatus.TIME_LIMIT, "pace": SolverStatus.TIME_LIMIT, "bounds": SolverStatus.FAILED,
-            "interrupted": SolverStatus.FAILED, "iterations": SolverStatus.ITERATION_LIMIT}
+            "interrupted": SolverStatus.FAILED}
 """Our status when the `_Deadline` callback stopped the solve, by its reason."""
 _STOP_MESSAGES = {"deadline": "stopped at the wall-time limit",
                   "pace": "stopped: at its pace, its iterations would not end within the wall-time limit",
                   "bounds": "stopped: iterate outside its bounds",
-                  "iterations": "stopped at the iteration limit",
                   "interrupted": "stopped by Ctrl-C"}
 
 
 @dataclass(frozen=True)
 class PreparedNlpsol(PreparedSolver):
     """The nlpsol `function` of `nlp`, its deadline callback (for plugins that stop by callback, else None)
-    and the `owner` solver whose limits and status table apply; `exact`, where `function` solves on a cheaper
-    Hessian (Ipopt), makes the nlpsol on the exact one, built on first use, that continues a solve which reached
-    that function's iteration cap."""
+    and the `owner` solver whose limits and status table apply."""
 
     nlp: NLP
     function: ca.Function
     deadline: _Deadline | None
     owner: CasadiNlpsol
-    exact: Callable[[], ca.Function] | None = None
 
     def solve(self, guess: np.ndarray, params: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
               max_wall_time: float | None = None, pace: int | None = None) -> SolverResult:
         """See `PreparedSolver.solve`; blocksqp and fatrop cannot be stopped at `max_wall_time` nor by `pace`
-        (module docstring). A solve on the cheaper Hessian that reaches its cap continues from its iterate on the
-        exact one, within the same limit and the owner's iterations left, and keeps the `pace` there too."""
+        (module docstring)."""
         start = time.perf_counter()
-        deadline = start + time_limit(self.owner.max_wall_time, max_wall_time)
-        first = self._call(self.function, guess, params, bounds, deadline, pace)
-        left = self.owner.max_iterations - first.iterations
-        if self.exact is None or first.status != SolverStatus.ITERATION_LIMIT or left <= 0:
-            return first
-        second = self._call(self.exact(), first.w, params, bounds, deadline, pace, left)
-        return _continued(first, second, time.perf_counter() - start)
-
-    def _call(self, function: ca.Function, guess: np.ndarray, params: np.ndarray,
-              bounds: tuple[np.ndarray, np.ndarray], deadline: float, pace: int | None,
-              cap: int | None = None) -> SolverResult:
-        """One call of `function` from `guess`, stopped at `deadline` (time.perf_counter s), by `pace` or after
-        `cap` iterations where it stops by callback."""
-        start = time.perf_counter()
+        limit = time_limit(self.owner.max_wall_time, max_wall_time)
         if self.deadline is not None:
-            self.deadline.arm(deadline, *(np.asarray(b, dtype=float) for b in bounds), pace, cap)
+            self.deadline.arm(start + limit, *(np.asarray(b, dtype=float) for b in bounds), pace)
         try:
             with _silenced_stdout():
-                out = function(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1], lbg=self.nlp.lbg, ubg=self.nlp.ubg)
-            stats = function.stats()
+                out = self.function(x0=guess, p=params, lbx=bounds[0], ubx=bounds[1],
+                                    lbg=self.nlp.lbg, ubg=self.nlp.ubg)
+            stats = self.function.stats()
         except RuntimeError as exc:  # a plugin's assertion or failed evaluation: a status, not a crash
             return SolverResult.failed(guess, start, str(exc))
         wall = time.perf_counter() - start
         message = str(stats.get("return_status", stats.get("unified_return_status", "unknown")))
         stopped = self.deadline.reason if self.deadline is not None else ""
-        status = _STOPPED.get(stopped) or self.owner.status(stats, message, time.perf_counter() > deadline)
+        status = _STOPPED.get(stopped) or self.owner.status(stats, message, wall > limit)
         return SolverResult(np.asarray(out["x"]).ravel(), status, self.owner.iterations(stats), wall,
                             _STOP_MESSAGES.get(stopped, message), stats,
                             np.asarray(out["lam_g"]).ravel(), np.asarray(out["lam_x"]).ravel())
-
-
-_SUMMED_STATS = ("t_wall_", "t_proc_", "n_call_")
-"""Prefixes of the nlpsol stats (times and call counts) that add up over a solve continued by another."""
-
-
-def _continued(first: SolverResult, second: SolverResult, wall: float) -> SolverResult:
-    """`second`, a solve continued from `first`'s iterate, with both solves' iterations, their stats' times and
-    call counts summed, and the `wall` time (s) of both with whatever ran between them."""
-    stats = {**second.stats, **{key: first.stats.get(key, 0) + value for key, value in second.stats.items()
-                                if key.startswith(_SUMMED_STATS)}}
-    return dataclasses.replace(second, iterations=first.iterations + second.iterations, wall_time=wall, stats=stats)
 
 
 class CasadiNlpsol(Solver):
@@ -241,27 +196,18 @@ class CasadiNlpsol(Solver):
         """nlpsol options of the plugin for this NLP (limits included)."""
 
     def prepare(self, nlp: NLP) -> PreparedNlpsol:
-        deadline = self._deadline(nlp)
-        return PreparedNlpsol(nlp, self._nlpsol(nlp, self.plugin_options(nlp), deadline), deadline, self)
-
-    def _deadline(self, nlp: NLP) -> _Deadline | None:
-        """The iteration callback of a plugin that stops by callback, else None."""
-        if not self.stops_by_callback:
-            return None
-        return _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel(), not self.stays_in_bounds)
-
-    def _nlpsol(self, nlp: NLP, plugin_options: dict, deadline: _Deadline | None) -> ca.Function:
-        """The plugin's nlpsol of `nlp` with `plugin_options` and the `deadline` callback; an OptionError when
-        the plugin rejects them."""
         problem = {"x": nlp.x, "p": nlp.p, "f": nlp.f, "g": nlp.g}
-        options = {"print_time": False, "record_time": True, "error_on_fail": False, **plugin_options}
+        options = {"print_time": False, "record_time": True, "error_on_fail": False, **self.plugin_options(nlp)}
+        deadline = _Deadline(nlp.x.numel(), nlp.g.numel(), nlp.p.numel(), not self.stays_in_bounds) \
+            if self.stops_by_callback else None
         if deadline is not None:
             options["iteration_callback"] = deadline
         try:
             with _silenced_stdout():
-                return ca.nlpsol(self.name, self.plugin, problem, options)
+                function = ca.nlpsol(self.name, self.plugin, problem, options)
         except RuntimeError as exc:  # an option or structure the plugin rejects: the caller's choice
             raise OptionError(f"{self.name} cannot be set up for this NLP: {_last_line(exc)}") from exc
+        return PreparedNlpsol(nlp, function, deadline, self)
 
     def iterations(self, stats: dict) -> int:
         """Iterations the plugin took, from its stats."""
@@ -293,13 +239,7 @@ class Ipopt(CasadiNlpsol):
     automatic choice takes PORD), both faster on our KKT systems. The barrier parameter stays below mu_max = 10⁻³
     (IPOPT's default 10⁵): the adaptive strategy otherwise falls back to a monotone barrier of ~0.1 on a slow
     iterate, which pushes a start near a solution far from it: t_f up towards its bound, then slowly back
-    (figures: docs/design-notes.md).
-
-    The cheaper Hessian: where the NLP has rows whose second derivatives cost most of an iteration
-    (`PointCall.costly_curvature`: the grouped collision rows of a spherized arm), a solve's first
-    `cheap_hessian_iterations` iterations use a Hessian without them, stopping once the objective and the
-    constraints have settled (CHEAP_HESSIAN_ACCEPTABLE), and a solve that reaches that cap goes on from its iterate
-    with the exact Hessian, whose nlpsol is built then (and kept). None or 0: the exact Hessian from the start."""
+    (figures: docs/design-notes.md)."""
 
     name = plugin = "ipopt"
     statuses = {
@@ -314,33 +254,17 @@ class Ipopt(CasadiNlpsol):
     stays_in_bounds = True  # an interior point
 
     def __init__(self, max_iterations: int = 1000, max_wall_time: float = 60.0, compiled: bool = True,
-                 cheap_hessian_iterations: int | None = CHEAP_HESSIAN_ITERATIONS, **ipopt_options) -> None:
+                 **ipopt_options) -> None:
         super().__init__(max_iterations, max_wall_time)
         self.compiled = compiled
-        self.cheap_hessian_iterations = min(cheap_hessian_iterations or 0, max_iterations)
         self.options = {"linear_solver": "mumps", "print_level": 0, "sb": "yes", "tol": 1e-6,
                         "mu_strategy": "adaptive", "mumps_pivtol": 0.0, "mumps_pivot_order": 2,
                         "mu_max": 1e-3, "max_iter": max_iterations, **ipopt_options}
 
-    def plugin_options(self, nlp: NLP, curvature: bool = True) -> dict:
-        """As `CasadiNlpsol.plugin_options`; without `curvature`, on the cheaper Hessian (class docstring)."""
-        derivatives = pointwise_derivatives(nlp, self.compiled, curvature) \
-            if nlp.point_calls and nlp.exact_hessian else {}
-        options = {**self.options, **({} if curvature else {**CHEAP_HESSIAN_ACCEPTABLE,
-                                                              "max_iter": self.cheap_hessian_iterations})}
-        return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **options}, **derivatives,
+    def plugin_options(self, nlp: NLP) -> dict:
+        derivatives = pointwise_derivatives(nlp, self.compiled) if nlp.point_calls and nlp.exact_hessian else {}
+        return {"ipopt": {"hessian_approximation": hessian_approximation(nlp), **self.options}, **derivatives,
                 **NO_PARAMETER_MULTIPLIERS}
-
-    def prepare(self, nlp: NLP) -> PreparedNlpsol:
-        """As `CasadiNlpsol.prepare`, on the cheaper Hessian where the NLP has rows of costly curvature (class
-        docstring), with the exact one's nlpsol built when a solve first needs it."""
-        if self.cheap_hessian_iterations <= 0 or not nlp.exact_hessian \
-                or not any(call.costly_curvature for call in nlp.point_calls):
-            return super().prepare(nlp)
-        deadline = self._deadline(nlp)
-        exact = functools.cache(lambda: self._nlpsol(nlp, self.plugin_options(nlp), deadline))
-        return PreparedNlpsol(nlp, self._nlpsol(nlp, self.plugin_options(nlp, curvature=False), deadline), deadline,
-                              self, exact)
 
 
 NO_PARAMETER_MULTIPLIERS = {"no_nlp_grad": True, "calc_lam_p": False}

@@ -44,11 +44,10 @@ knots, so each chunk needs few sweeps over a small graph, where all rows at once
 them (figures: docs/design-notes.md)."""
 
 
-def pointwise_derivatives(nlp: NLP, compile: bool = True, curvature: bool = True) -> dict[str, ca.Function]:
+def pointwise_derivatives(nlp: NLP, compile: bool = True) -> dict[str, ca.Function]:
     """IPOPT's {"jac_g": (x, p) → (g, ∂g/∂x), "hess_lag": (x, p, λ_f, λ_g) → upper triangle of
     ∇²ₓ(λ_f f + λ_gᵀ g)} for `nlp` (SX, with point calls), built as the module docstring says; `compile`: the
-    calls marked `compiled` through compiled point functions; without `curvature`, the Hessian leaves out the
-    second derivatives of the calls marked `costly_curvature` (a cheaper, inexact Hessian)."""
+    calls marked `compiled` through compiled point functions."""
     maps: dict[tuple[int, ...], InputMap] = {}  # by the inputs' identities: calls at a point share them
 
     def input_map(call: PointCall) -> InputMap:
@@ -63,11 +62,10 @@ def pointwise_derivatives(nlp: NLP, compile: bool = True, curvature: bool = True
     objective_map = None if objective is None else input_map(objective)
     objective_map = objective_map if isinstance(objective_map, sps.csr_matrix) else None  # placed as a constant
     if not mapped and objective_map is None:
-        return _graph_derivatives(nlp, kept, np.zeros(0, dtype=int), objective, curvature)
+        return _graph_derivatives(nlp, kept, np.zeros(0, dtype=int), objective)
     left = np.concatenate([np.zeros(0, dtype=int), *(_rows(call) for call, _ in mapped)])
-    graphs = _graph_derivatives(nlp, kept, left, objective if objective_map is None else None, curvature)
-    terms = _mapped_terms(nlp, mapped, None if objective_map is None else (objective, objective_map), compile,
-                          curvature)
+    graphs = _graph_derivatives(nlp, kept, left, objective if objective_map is None else None)
+    terms = _mapped_terms(nlp, mapped, None if objective_map is None else (objective, objective_map), compile)
     return _joined(nlp, graphs, terms)
 
 
@@ -92,17 +90,16 @@ def _rows(call: PointCall) -> np.ndarray:
 
 
 def _graph_derivatives(nlp: NLP, point_calls: list[PointCall], left: np.ndarray,
-                       objective_call: PointCall | None, curvature: bool = True) -> dict[str, ca.Function]:
+                       objective_call: PointCall | None) -> dict[str, ca.Function]:
     """The derivatives as SX graphs, of g's rows less `left` (rows another term gives: zero here), the objective's
-    through `objective_call` if given, not at all if the NLP has a call for it elsewhere (mapped); `curvature` as
-    for `pointwise_derivatives`."""
+    through `objective_call` if given, not at all if the NLP has a call for it elsewhere (mapped)."""
     x, p, f, g = nlp.x, nlp.p, nlp.f, nlp.g
     lam_f, lam_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g.numel())
     rows = [_rows(c) for c in point_calls]
     calls = [*zip(point_calls, (lam_g[r.tolist()] for r in rows))]
     if objective_call is not None:
         calls.append((objective_call, lam_f))
-    A, jacobians, hessians = _chain(calls, x, curvature)
+    A, jacobians, hessians = _chain(calls, x)
     called = np.concatenate([*rows, left]).astype(int)
     others = np.setdiff1d(np.arange(g.numel()), called).tolist()
     rest = g[others]
@@ -135,11 +132,11 @@ def _joined(nlp: NLP, graphs: dict[str, ca.Function],
 
 def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
                   objective: tuple[PointCall, sps.csr_matrix] | None,
-                  compile: bool, curvature: bool = True) -> tuple[ca.Function, ca.Function]:
+                  compile: bool) -> tuple[ca.Function, ca.Function]:
     """MX Functions (x, p → the `mapped` calls' rows of ∂g/∂x; x, p, λ_f, λ_g → their part, and the `objective`
     call's, of the Hessian's upper triangle) for calls whose input maps A are constant or functions of p (module
     docstring): one point function's derivatives mapped over all its calls, compiled where every call is marked
-    `compiled` (and `compile`), else run by CasADi's virtual machine; `curvature` as for `pointwise_derivatives`."""
+    `compiled` (and `compile`), else run by CasADi's virtual machine."""
     x, p, n_x, n_g = nlp.x, nlp.p, nlp.x.numel(), nlp.g.numel()
     X, P = ca.MX.sym("x", n_x), ca.MX.sym("p", nlp.p.numel())
     lam_f, lam_g = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", n_g)
@@ -149,8 +146,7 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
     derivatives, marked = [], []
     for calls in groups.values():
         names = (f"jac_{len(marked)}", f"hess_{len(marked)}")  # the compiled ones named alike for every problem
-        derivatives.append(_point_nonzeros(calls[0][0].function, len(calls[0][0].inputs), names,
-                                           curvature or not calls[0][0].costly_curvature))
+        derivatives.append(_point_nonzeros(calls[0][0].function, len(calls[0][0].inputs), names))
         if compile and all(call.compiled for call, _ in calls):
             marked.append(len(derivatives) - 1)
     loaded = compiled([f for k in marked for f, _ in derivatives[k]]) if marked else None
@@ -159,7 +155,7 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
     jacobians, hessians, jacobian_places, hessian_places = [], [], [], []
     jacobian_sums, hessian_sums = [], []  # the terms of calls with parametric A, as MX matrices
     for calls, ((jacobian, jacobian_sparsity), (hessian, hessian_sparsity)) in zip(groups.values(), derivatives):
-        arguments = _mapped_arguments([call for call, _ in calls], x, p).call([X, P])  # a list, even of one
+        arguments = _mapped_arguments([call for call, _ in calls], x, p)(X, P)
         rows = [_rows(call) for call, _ in calls]
         weights = ca.reshape(lam_g[np.concatenate(rows).tolist()], -1, len(calls))
         blocks = jacobian.map(len(calls))(*arguments), hessian.map(len(calls))(*arguments, weights)
@@ -181,7 +177,7 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
     if objective is not None:
         call, a = objective
         _, (hessian, sparsity) = _point_nonzeros(call.function, len(call.inputs), ("objective_jac", "objective_hess"))
-        hessians.append(hessian(*_mapped_arguments([call], x, p).call([X, P]), lam_f))
+        hessians.append(hessian(*_mapped_arguments([call], x, p)(X, P), lam_f))
         hessian_places.append((sparsity, a, a))
     jacobian_nonzeros = ca.vertcat(*jacobians) if jacobians else ca.MX(0, 1)
     jac = _placed(jacobian_places, jacobian_nonzeros, n_g, n_x) + sum(jacobian_sums, ca.MX(n_g, n_x))
@@ -233,17 +229,15 @@ def _spread(matrix: sps.csr_matrix, rows: np.ndarray) -> tuple[np.ndarray, np.nd
     return owner, matrix.indices[position], matrix.data[position]
 
 
-def _chain(calls: list[tuple[PointCall, ca.SX]], x: ca.SX,
-           curvature: bool = True) -> tuple[ca.SX, list[ca.SX], list[ca.SX]]:
+def _chain(calls: list[tuple[PointCall, ca.SX]], x: ca.SX) -> tuple[ca.SX, list[ca.SX], list[ca.SX]]:
     """(A = ∂Z/∂x with Z every call's z stacked, [∂F/∂z(z_k)], [∇²_z(λ_kᵀF)(z_k)]) for (call, λ_k) pairs; an input
-    object shared by several calls is differentiated once; `curvature` as for `pointwise_derivatives`."""
+    object shared by several calls is differentiated once."""
     derivatives: dict[int, tuple[ca.Function, ca.Function]] = {}
     offsets: dict[int, int] = {}  # id of an input → its first row in Z
     unique, positions, jacobians, hessians, size = [], [], [], [], 0
     for call, weights in calls:
         if id(call.function) not in derivatives:
-            derivatives[id(call.function)] = _point_derivatives(call.function, len(call.inputs),
-                                                                curvature or not call.costly_curvature)
+            derivatives[id(call.function)] = _point_derivatives(call.function, len(call.inputs))
         jacobian, hessian = derivatives[id(call.function)]
         jacobians.append(jacobian(*call.inputs, *call.parameters))
         hessians.append(hessian(*call.inputs, *call.parameters, weights))
@@ -266,30 +260,27 @@ def _second_order(calls: list[tuple[PointCall, ca.SX]], jacobians: list[ca.SX], 
     return ca.substitute(ca.hessian(ca.dot(symbols, Z), x)[0], symbols, v)
 
 
-def _point_derivatives(function: ca.Function, differentiated: int,
-                       curvature: bool = True) -> tuple[ca.Function, ca.Function]:
+def _point_derivatives(function: ca.Function, differentiated: int) -> tuple[ca.Function, ca.Function]:
     """(∂F/∂z, ∇²_z(λᵀF)) of a point function F whose first `differentiated` inputs make z, as Functions of F's
-    inputs (and λ, one per output row); without `curvature` the second is zero."""
-    symbols, lam, jacobian, hessian = _derivative_expressions(function, differentiated, curvature)
+    inputs (and λ, one per output row)."""
+    symbols, lam, jacobian, hessian = _derivative_expressions(function, differentiated)
     return (ca.Function("point_jacobian", symbols, [jacobian]),
             ca.Function("point_hessian", [*symbols, lam], [hessian]))
 
 
-def _point_nonzeros(function: ca.Function, differentiated: int, names: tuple[str, str],
-                    curvature: bool = True) -> list[tuple[ca.Function, ca.Sparsity]]:
+def _point_nonzeros(function: ca.Function, differentiated: int,
+                    names: tuple[str, str]) -> list[tuple[ca.Function, ca.Sparsity]]:
     """As `_point_derivatives`, each derivative as (a Function so named whose one output is the column of its
     nonzeros, its sparsity)."""
-    symbols, lam, jacobian, hessian = _derivative_expressions(function, differentiated, curvature)
+    symbols, lam, jacobian, hessian = _derivative_expressions(function, differentiated)
     return [(ca.Function(name, inputs, [ca.vec(d.nz[:])]), d.sparsity())  # a column even for a one-row F
             for name, inputs, d in zip(names, (symbols, [*symbols, lam]), (jacobian, hessian))]
 
 
-def _derivative_expressions(function: ca.Function, differentiated: int,
-                            curvature: bool = True) -> tuple[list[ca.SX], ca.SX, ca.SX, ca.SX]:
-    """(F's input symbols, λ, ∂F/∂z, ∇²_z(λᵀF), or a zero one without `curvature`) for `_point_derivatives`."""
+def _derivative_expressions(function: ca.Function, differentiated: int) -> tuple[list[ca.SX], ca.SX, ca.SX, ca.SX]:
+    """(F's input symbols, λ, ∂F/∂z, ∇²_z(λᵀF)) for `_point_derivatives`."""
     symbols = [ca.SX.sym(function.name_in(i), function.size_in(i)) for i in range(function.n_in())]
     rows = function(*symbols)
     z = ca.vertcat(*(ca.vec(s) for s in symbols[:differentiated]))
     lam = ca.SX.sym("lam", rows.numel())
-    hessian = ca.hessian(ca.dot(lam, rows), z)[0] if curvature else ca.SX(z.numel(), z.numel())
-    return symbols, lam, ca.jacobian(rows, z), hessian
+    return symbols, lam, ca.jacobian(rows, z), ca.hessian(ca.dot(lam, rows), z)[0]

@@ -251,7 +251,6 @@ def test_a_spherized_arm_gets_one_row_per_group_never_above_its_smallest_term():
     problem = ocpkit.load_scenario(REPO / "scenarios/mbm/panda/box/0001.yaml")
     grouped = SphereCollision(problem)
     assert grouped.grouped and not SphereCollision(PROBLEM).grouped
-    assert grouped.costly_curvature and not SphereCollision(PROBLEM).costly_curvature  # for Ipopt's first Hessian
     each = copy.copy(grouped)
     each.grouped = False
     joint = problem.robot.sphere_joint

@@ -153,24 +153,16 @@ def test_a_callback_backend_gives_no_point_calls():
     assert discretization.nlp.point_calls == () and discretization.nlp.objective_call is None
 
 
-@pytest.fixture(scope="module")
-def mbm():
-    """An MBM Panda problem (grouped collision rows) on a screened Chebyshev grid of 6 knots, and CasADi's own
-    derivatives of it."""
+def test_check_points_whose_times_are_parameters_are_mapped_too():
+    """A check point's inputs are linear in w with coefficients set by its time, an NLP parameter (refinement
+    rounds move it): its derivatives join through ∂z/∂w as a function of p, the same values as CasADi's own."""
     problem = load_scenario(REPO / "scenarios/mbm/panda/table_pick/0001.yaml")
     constraints = make_constraints(problem, screen=(screening.line_samples(problem), 0.05))
     discretization = TRANSCRIPTIONS.get("chebyshev")(knots=6).build(
         problem, make_dynamics("casadi-rnea", problem.robot), constraints)
-    return problem, discretization, _reference(discretization.nlp)
-
-
-def test_check_points_whose_times_are_parameters_are_mapped_too(mbm):
-    """A check point's inputs are linear in w with coefficients set by its time, an NLP parameter (refinement
-    rounds move it): its derivatives join through ∂z/∂w as a function of p, the same values as CasADi's own."""
-    problem, discretization, reference = mbm
     nlp = discretization.nlp
     assert sum(isinstance(_input_map(call, nlp), ca.SX) for call in nlp.point_calls) >= 8
-    ours = pointwise_derivatives(nlp)
+    ours, reference = pointwise_derivatives(nlp), _reference(nlp)
     params = discretization.parameters(problem, Refinement(np.array([0.3, 0.55, 0.8])))
     w = discretization.initial_guess(problem) + 0.05 * np.random.default_rng(0).standard_normal(nlp.x.numel())
     lam = (1.3, np.random.default_rng(1).standard_normal(nlp.g.numel()))
@@ -178,26 +170,3 @@ def test_check_points_whose_times_are_parameters_are_mapped_too(mbm):
     np.testing.assert_allclose(ca.densify(ours["jac_g"](w, params)[1]).full(), jac_expected, rtol=1e-9, atol=1e-9)
     hess = ca.densify(ours["hess_lag"](w, params, *lam)).full()
     np.testing.assert_allclose(hess, hess_expected, rtol=1e-9, atol=1e-9 * np.abs(hess_expected).max())
-
-
-def test_the_cheaper_hessian_leaves_out_the_costly_rows_curvature_and_nothing_else(mbm):
-    """Without `curvature`: the same Jacobian, and the Lagrangian's Hessian with the multipliers of the rows marked
-    costly_curvature (the grouped collision rows, whose inputs are linear in w) set to zero: CasADi's own."""
-    problem, discretization, reference = mbm
-    nlp = discretization.nlp
-    costly = np.concatenate([call.first_row + np.arange(call.function.numel_out(0))
-                             for call in nlp.point_calls if call.costly_curvature])
-    assert 0 < len(costly) < nlp.g.numel()
-    ours = pointwise_derivatives(nlp, curvature=False)
-    params = discretization.parameters(problem)
-    rng = np.random.default_rng(2)
-    w = discretization.initial_guess(problem) + 0.05 * rng.standard_normal(nlp.x.numel())
-    lam_g = rng.standard_normal(nlp.g.numel())
-    kept = lam_g.copy()
-    kept[costly] = 0.0
-    jac_expected, hess_expected = (ca.densify(m).full() for m in reference(w, params, 1.3, kept))
-    np.testing.assert_allclose(ca.densify(ours["jac_g"](w, params)[1]).full(), jac_expected, rtol=1e-9, atol=1e-9)
-    hess = ca.densify(ours["hess_lag"](w, params, 1.3, lam_g)).full()
-    np.testing.assert_allclose(hess, hess_expected, rtol=1e-9, atol=1e-9 * np.abs(hess_expected).max())
-    exact = ca.densify(pointwise_derivatives(nlp)["hess_lag"](w, params, 1.3, lam_g)).full()
-    assert not np.allclose(exact, hess)  # the left-out curvature is not nothing

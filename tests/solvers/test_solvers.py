@@ -8,12 +8,11 @@ import functools
 import numpy as np
 import pytest
 from helpers import REPO
-from toy_nlps import BOUNDS, DISK, GUESS, PARAMS, optimum, rosenbrock_costly_disk, rosenbrock_disk
+from toy_nlps import BOUNDS, DISK, GUESS, PARAMS, optimum, rosenbrock_disk
 
 import ocpkit
 from ocpkit.errors import OptionError
 from ocpkit.solvers.base import SOLVERS, SolverStatus
-from ocpkit.solvers.casadi_nlpsol import Ipopt
 
 
 
@@ -116,40 +115,6 @@ def test_a_solve_whose_pace_cannot_fit_its_iterations_in_its_time_stops_early(na
 def test_an_uninterruptible_solver_reports_an_overrun_of_the_per_call_limit(name):
     prepared = ALL_SOLVERS[name](max_wall_time=60.0, max_iterations=2).prepare(rosenbrock_disk())
     assert prepared.solve(GUESS, PARAMS, BOUNDS, max_wall_time=1e-9).status == SolverStatus.TIME_LIMIT
-
-
-def test_ipopt_starts_on_the_cheaper_hessian_and_goes_on_with_the_exact_one_after_its_cap():
-    """Rows marked costly_curvature leave the first iterations' Hessian; a solve that reaches that cap goes on from
-    its iterate with the exact Hessian, whose nlpsol is built then, and reports both solves' iterations."""
-    prepared = Ipopt(cheap_hessian_iterations=2).prepare(rosenbrock_costly_disk())
-    assert prepared.exact.cache_info().currsize == 0  # not built before a solve needs it
-    result = prepared.solve(GUESS, PARAMS, BOUNDS)
-    assert result.status == SolverStatus.CONVERGED, result.message
-    np.testing.assert_allclose(result.w, optimum(), atol=1e-4)
-    assert result.iterations > 2 and prepared.exact.cache_info().currsize == 1
-    assert result.stats["t_wall_total"] > 0
-
-
-def test_the_continued_solve_keeps_the_solvers_iteration_limit():
-    result = Ipopt(max_iterations=5, cheap_hessian_iterations=2).solve(rosenbrock_costly_disk(), GUESS, PARAMS,
-                                                                        BOUNDS)
-    assert result.status == SolverStatus.ITERATION_LIMIT and result.iterations == 5, result.message
-
-
-def test_a_solve_that_settles_on_the_cheaper_hessian_never_builds_the_exact_one():
-    prepared = Ipopt(cheap_hessian_iterations=500).prepare(rosenbrock_costly_disk())
-    result = prepared.solve(GUESS, PARAMS, BOUNDS)
-    assert result.status == SolverStatus.CONVERGED, result.message
-    np.testing.assert_allclose(result.w, optimum(), atol=1e-4)
-    assert prepared.exact.cache_info().currsize == 0
-
-
-@pytest.mark.parametrize("nlp, cheap", [(rosenbrock_disk(), 80), (rosenbrock_costly_disk(), 0),
-                                        (rosenbrock_costly_disk(), None)])
-def test_the_exact_hessian_from_the_start_without_costly_rows_or_when_told(nlp, cheap):
-    prepared = Ipopt(cheap_hessian_iterations=cheap).prepare(nlp)
-    assert prepared.exact is None
-    assert prepared.solve(GUESS, PARAMS, BOUNDS).status == SolverStatus.CONVERGED
 
 
 CASE2 = REPO / "scenarios/paper/case2.yaml"
