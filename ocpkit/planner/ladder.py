@@ -35,11 +35,13 @@ iterations and ends infeasible or at its cap. For such a problem `ordered` moves
 line after the first OMPL rung, whose path starts clear of the obstacles.
 
 The default budget, MAX_WALL_TIME, leaves room for the capped first rung and an OMPL rung on a hard problem
-(MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified
-plan returns at once; the budget is what a failure costs. A rung's last solve is verified after the rung's time is
-up, so each rung is given the time left less the longest verification seen so far in the climb: the budget bounds
-the verifications too. A capped rung (one with an iteration cap) also gets at
-most RUNG_SHARE of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP)
+(MotionBenchMaker's shelves and cages: each 5-15 s with its set-up). A verified plan returns at once; the budget
+is what a failure costs. A rung's last solve is verified after the rung's time is up, so each rung is given the
+time left less the longest verification seen so far in the climb and less RESERVE_SHARE of the budget: the budget
+bounds the verifications too, and the reserve covers what else runs past a rung's time (its last iteration, which
+ends after the deadline it checks, a verification of a longer motion than any before it, a safety net's smoothing
+and TOPP-RA timing before its first solve). A capped rung (one with an iteration cap) also gets at most RUNG_SHARE
+of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP)
 then ends by time, not after the whole budget, so the safety net and another rung still get their turn. A ladder
 that verifies nothing, where every OMPL rung found no path, ends `no_path`, with the configurations the last
 search checked: where the obstacles leave no way through, that is the evidence, and no failed solve says more.
@@ -94,6 +96,7 @@ OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.plann
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 PACE_ITERATIONS = 250  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
 RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take
+RESERVE_SHARE = 0.03  # of the budget: held back from every rung for what runs past its time (module docstring)
 NET_KNOTS, NET_SEGMENTS = 8, 4  # a safety net's timing grid: 4 pseudospectral segments of 8 intervals (docstring)
 
 
@@ -222,17 +225,19 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     `max_wall_time` (s) of computation and set-up is spent (no rung starts with less time left than
     the last rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module
     docstring). A rung may take the time left, less the longest verification of the rungs before it (its last
-    solve's verification runs after its time is up), a capped one at most RUNG_SHARE of `max_wall_time`. A safety
+    solve's verification runs after its time is up) and RESERVE_SHARE of `max_wall_time`, a capped one at most
+    RUNG_SHARE of `max_wall_time`. A safety
     net runs only where an OMPL rung of its seed found a path."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []
     skipped: list[str] = []
-    share = RUNG_SHARE * max_wall_time
+    share, reserve = RUNG_SHARE * max_wall_time, RESERVE_SHARE * max_wall_time
 
-    def left() -> float:  # less the longest verification so far: a rung's last one runs after its time is up
+    def left() -> float:  # less the longest verification so far (a rung's last one runs after its time is up)
         spent = sum(p.stats.solve_time + p.stats.setup_time for _, p in tried)
-        return max_wall_time - spent - max((r.verify for _, p in tried for r in p.stats.timing.rounds), default=0.0)
+        verifying = max((r.verify for _, p in tried for r in p.stats.timing.rounds), default=0.0)
+        return max_wall_time - spent - verifying - reserve
 
     def room() -> bool:  # time for a build as long as the last one: a rung that cannot build only overruns
         return not tried or left() > tried[-1][1].stats.setup_time
