@@ -60,14 +60,21 @@ class Check:
 
 @dataclass(frozen=True)
 class Verification:
-    """The result of `verify`: every check, and the sample times where fixable path violations occur."""
+    """The result of `verify`: every check, and the sample times where fixable path violations occur; or, for a
+    motion that was not verified (`not_run`), no checks and why not (`skipped`)."""
 
     checks: tuple[Check, ...]
     violation_times: np.ndarray  # (k,) seconds, worst first, of path-constraint violations
+    skipped: str = ""  # why the motion was not verified; "" when it was
+
+    @classmethod
+    def not_run(cls, why: str) -> Verification:
+        """The verification of a motion that was not verified, and `why`: never ok, nothing to refine."""
+        return cls((), np.zeros(0), why)
 
     @property
     def ok(self) -> bool:
-        return all(c.ok for c in self.checks)
+        return not self.skipped and all(c.ok for c in self.checks)
 
     @property
     def fixable(self) -> bool:
@@ -86,7 +93,10 @@ class Verification:
         return max([0.0] + [c.worst for c in self.checks if c.name in GEOMETRY_CHECKS])
 
     def summary(self) -> str:
-        """One line: the failed checks with their times, or every check's worst value if all pass."""
+        """One line: the failed checks with their times, or every check's worst value if all pass (or why the
+        motion was not verified)."""
+        if self.skipped:
+            return f"not verified: {self.skipped}"
         failed = [c for c in self.checks if not c.ok]
         if failed:
             return "FAILED " + ", ".join(f"{c.name} {c.worst:+.3g} {c.unit} > {c.tolerance:g} at t={c.time:.3f} s"

@@ -13,7 +13,7 @@ from helpers import REPO, monomial, polynomial_motion
 import ocpkit
 from ocpkit import result as result_module
 from ocpkit.errors import OptionError, ScenarioError
-from ocpkit.formats.record import Recorded, result_row
+from ocpkit.formats.record import Recorded, result_row, trajectory_header
 from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Scene
 from ocpkit.planner import PLANNERS
@@ -125,6 +125,14 @@ def test_a_results_row_reads_back_old_and_new(motion):
     assert Recorded.of(old).extra["rungs"][0]["time_s"] == 0.281
     assert set(Recorded.of(old).extra["timing"]) == set(recorded.extra["timing"]) == {"guess", "rounds", "setup"}
     assert Recorded.of({**row, "extra": ""}).extra == {}
+
+
+def test_a_motion_that_was_not_verified_has_no_checks_and_no_violation_figure(motion):
+    result = finish(FREE, motion, "time_limit", {}, 0.0, verification=Verification.not_run("stopped by time"))
+    row = result_row("mbm", "box_0001", result, 1.0, 0.5)
+    assert result.status == "time_limit" and row["checks"] == "not verified: stopped by time"
+    assert np.isnan(row["max_violation"]) and np.isnan(Recorded.of({k: str(v) for k, v in row.items()}).max_violation)
+    assert trajectory_header(FREE, result)["checks"] == []
 
 
 @pytest.fixture

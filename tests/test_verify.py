@@ -9,6 +9,7 @@ import pytest
 from helpers import REPO, quintic
 
 from ocpkit import load_scenario, verify
+from ocpkit.verify import Verification
 from ocpkit.formats.trajectory import Samples, Trajectory
 
 PROBLEM = load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -136,3 +137,9 @@ def test_a_position_limit_is_hard_half_a_percent_past_is_violated_naming_joint_a
 def test_round_off_past_a_position_limit_passes():
     checks = by_name(verify(limited_above(PROBLEM, RISING, 5e-5), quintic(PROBLEM, 4.0)))
     assert checks["position"].ok and checks["position"].worst == pytest.approx(5e-5, rel=1e-6)
+
+
+def test_a_motion_that_was_not_verified_is_never_ok_and_says_why():
+    unverified = Verification.not_run("stopped by time")
+    assert not unverified.ok and not unverified.fixable and unverified.checks == ()
+    assert unverified.summary() == "not verified: stopped by time"

@@ -70,5 +70,7 @@ class Recorded:
 
 def max_violation(plan: Plan) -> float:
     """The largest excess of any checked quantity over its limit (relative for limits and dynamics, metres for
-    sphere contact, rad for boundary errors), 0 if none."""
+    sphere contact, rad for boundary errors), 0 if none, nan for a motion that was not verified."""
+    if plan.verification.skipped:
+        return float("nan")
     return max([0.0] + [c.worst for c in plan.verification.checks])

@@ -62,8 +62,8 @@ all, its refinement rounds included, on a plan that verifies (most take far fewe
 run that many without verifying): a rung that could not do that much work in its time would end at its time
 limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
 of self-collision rows) it gives that time to the safety net, which times the same path, instead (no screening
-rebuild follows a solve stopped by time: ocpkit.planner.simultaneous); a solve whose iterations are fast enough
-never notices the pace.
+rebuild follows a solve stopped by time: ocpkit.planner.simultaneous, and its motion is not verified:
+ocpkit.planner.refinement.paced_out); a solve whose iterations are fast enough never notices the pace.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
@@ -80,6 +80,8 @@ import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.result import Plan, RungRow
@@ -214,8 +216,9 @@ def ordered(ladder: Sequence[Rung], line_buried: bool) -> tuple[Rung, ...]:
 
 def rank(plan: Plan) -> tuple[int, float]:
     """Sort key of a plan, smaller is better: its status by STATUS_ORDER, then its largest failed check's worst
-    value (the check's unit: relative for limits, m for contact)."""
-    worst = max((c.worst for c in plan.verification.checks if not c.ok), default=0.0)
+    value (the check's unit: relative for limits, m for contact; inf for a motion that was not verified)."""
+    worst = np.inf if plan.verification.skipped else \
+        max((c.worst for c in plan.verification.checks if not c.ok), default=0.0)
     return STATUS_ORDER.index(plan.status) if plan.status in STATUS_ORDER else len(STATUS_ORDER), worst
 
 

@@ -39,6 +39,9 @@ RELAXED = Refinement(extra_margin=-0.02, limit_scale=1.5)  # a continuation's fi
 NAMED_PARTS = ("tf", "q", "qd", "qdd", "u", "s", "sd", "sdd")  # parts of w named in out-of-bounds messages
 
 
+UNPACED = "its solve stopped by time, at the pace its rung keeps (ocpkit.planner.ladder)"
+"""Why a motion is not verified (`paced_out`)."""
+
 CALLBACKS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l", "callback_fun", "total")
 """What a CasADi solver's stats time (t_wall_<kind>): the NLP function and derivative evaluations by kind, the
 iteration callback (Python), and the whole solver call."""
@@ -83,6 +86,14 @@ def margin_step(penetration: float) -> float:
     return max(PENETRATION_FACTOR * penetration, MIN_MARGIN_STEP) if penetration > 0 else 0.0
 
 
+def paced_out(result: SolverResult, pace: int | None, taken: int) -> bool:
+    """Whether `result`, a solve after `taken` refinement rounds, is a first solve with a `pace` that stopped by
+    time. Its motion is not verified: a solve stopped by time is never `verified` whatever its checks say, its
+    rung hands the rest of its time on (ocpkit.planner.ladder: the safety net times the same path), and on a large
+    NLP, where the pace stops a solve, a dense verification takes as long as a few of its iterations."""
+    return pace is not None and taken == 0 and result.status == SolverStatus.TIME_LIMIT
+
+
 def solve_refined(discretization: Discretization, solver: PreparedSolver, problem: Problem, guess: np.ndarray,
                   rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf, relaxed: Refinement | None = None,
                   iteration_budget: float = np.inf,
@@ -92,7 +103,8 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
     iterations, nor once `lacking` says an unverified trajectory needs rows this NLP does not have (screening:
     the caller rebuilds instead). With `relaxed` (continuation), a first solve of the problem
     relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status.
-    `pace` is the first solve's (PreparedSolver.solve): the rounds after it start near a solution."""
+    `pace` is the first solve's (PreparedSolver.solve): the rounds after it start near a solution. A first solve
+    stopped by time under a pace is not verified (`paced_out`)."""
     refinement, iterations, taken, timing = Refinement(), 0, 0, []
     if relaxed is not None:
         bounds = discretization.bounds(problem, relaxed)
@@ -109,7 +121,7 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         iterations += result.iterations
         trajectory = discretization.decode(result.w)
         verified = time.perf_counter()
-        verification = verify(problem, trajectory)
+        verification = Verification.not_run(UNPACED) if paced_out(result, pace, taken) else verify(problem, trajectory)
         timing.append(round_timing(result, time.perf_counter() - verified))
         following = next_refinement(refinement, verification, trajectory.tf)
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:

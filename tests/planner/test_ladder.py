@@ -118,6 +118,12 @@ def test_rank_orders_by_status_then_violation():
         ("verified", 0.0), ("violated", 0.1), ("violated", 0.3), ("infeasible", 0.0), ("time_limit", 0.0)]
 
 
+def test_a_motion_that_was_not_verified_ranks_last_among_plans_of_its_status():
+    unverified = dataclasses.replace(fake("time_limit"), verification=Verification.not_run("stopped"))
+    plans = [unverified, fake("time_limit", 0.3), fake("no_path")]
+    assert sorted(plans, key=rank) == [plans[1], unverified, plans[2]]
+
+
 def test_every_rung_gets_the_time_left_and_none_starts_after_the_budget():
     script = Script({"a": fake("infeasible", seconds=5.0), "b": fake("iteration_limit", seconds=4.0),
                      "c": fake("verified")})

@@ -12,7 +12,7 @@ import ocpkit
 from ocpkit.nlp import Refinement
 from ocpkit.planner.build_cache import build
 from ocpkit.planner.refinement import (DEFAULT_ROUNDS, LIMIT_BACKOFF, MIN_MARGIN_STEP, MIN_SHRINK, PENETRATION_FACTOR,
-                                       RELAXED, margin_step, next_refinement, solve_refined)
+                                       RELAXED, UNPACED, margin_step, next_refinement, solve_refined)
 from ocpkit.solvers import SolverResult, SolverStatus
 from ocpkit.verify import Check, Verification
 
@@ -137,6 +137,30 @@ def test_only_the_first_solve_keeps_a_pace_the_rounds_start_near_a_solution(monk
     solver = Converges(10)
     solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), rounds=2, pace=100)
     assert solver.paces == [100, None, None]
+
+
+class StopsByTime(Converges):
+    """A solver whose solves all stop by time after `iterations` iterations."""
+
+    def solve(self, guess, parameters, bounds, max_wall_time=None, pace=None):
+        result = super().solve(guess, parameters, bounds, max_wall_time, pace)
+        return SolverResult(result.w, SolverStatus.TIME_LIMIT, self.iterations, 0.0, "stopped")
+
+
+@pytest.mark.parametrize("pace, verified", [(100, False), (None, True)])
+def test_a_first_solve_stopped_by_time_under_a_pace_is_not_verified(pace, verified, monkeypatch):
+    """Its rung hands its time on: a dense verification there would only spend it (the same solve without a
+    pace is verified, to report how far its motion is from a plan)."""
+    calls = []
+    checked = sys.modules["ocpkit.planner.refinement"].verify
+    monkeypatch.setattr(sys.modules["ocpkit.planner.refinement"], "verify",
+                        lambda *args: calls.append(1) or checked(*args))
+    discretization = build(CASE2, knots=6).discretization
+    refined = solve_refined(discretization, StopsByTime(5), CASE2, discretization.initial_guess(CASE2), pace=pace)
+    assert refined.result.status == SolverStatus.TIME_LIMIT and refined.iterations == 5
+    assert bool(calls) == verified and not refined.verification.ok
+    assert bool(refined.verification.checks) == verified
+    assert (refined.verification.skipped == UNPACED) != verified
 
 
 def test_no_refinement_round_starts_once_the_motion_needs_rows_the_nlp_lacks(monkeypatch):
