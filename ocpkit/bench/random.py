@@ -29,6 +29,7 @@ import yaml
 from ocpkit.baselines.ompl_toppra import joint_path
 from ocpkit.bench.common import machine
 from ocpkit.errors import ScenarioError
+from ocpkit.planner.ompl_seed import OMPL_RANGE
 from ocpkit.formats.record import RESULT_COLUMNS, result_row, trajectory_header
 from ocpkit.formats.trajectory import write_json
 from ocpkit.geometry.clearances import sphere_centers
@@ -79,7 +80,8 @@ def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
 
 def _passable(problem: Problem) -> bool:
     """Whether the room-to-pass certificate's search connects `problem`'s start and goal (module docstring)."""
-    return joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS, max_step=None) is not None
+    return joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS,
+                      max_step=OMPL_RANGE) is not None
 
 
 def _obstacles(rng: np.random.Generator, robot: Robot, start: np.ndarray, goal: np.ndarray,
