@@ -29,13 +29,13 @@ import yaml
 from ocpkit.baselines.ompl_toppra import joint_path
 from ocpkit.bench.common import machine
 from ocpkit.errors import ScenarioError
-from ocpkit.planner.ompl_seed import OMPL_RANGE
 from ocpkit.formats.record import RESULT_COLUMNS, result_row, trajectory_header
 from ocpkit.formats.trajectory import write_json
 from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Scene, Workspace
 from ocpkit.planner import plan
 from ocpkit.planner.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung
+from ocpkit.planner.ompl_seed import OMPL_RANGE
 from ocpkit.problem import Problem, TimeBounds
 from ocpkit.result import Plan
 from ocpkit.robots import Robot, load_robot

@@ -41,8 +41,8 @@ time left less the longest verification seen so far in the climb and less RESERV
 bounds the verifications too, and the reserve covers what else runs past a rung's time (its last iteration, which
 ends after the deadline it checks, a verification of a longer motion than any before it, a safety net's smoothing
 and TOPP-RA timing before its first solve). A capped rung (one with an iteration cap) also gets at most RUNG_SHARE
-of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP)
-then ends by time, not after the whole budget, so the safety net and another rung still get their turn. A ladder
+of the budget: a solve that creeps towards its cap (a few hundred slow iterations on a large NLP) then ends by
+time, not after the whole budget, so the safety net and another rung still get their turn. A ladder
 that verifies nothing, where every OMPL rung found no path, ends `no_path`, with the configurations the last
 search checked: where the obstacles leave no way through, that is the evidence, and no failed solve says more.
 
@@ -229,8 +229,7 @@ def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung],
     the last rung's set-up took); that plan, else the best by `rank`, with the stats of all attempts (module
     docstring). A rung may take the time left, less the longest verification of the rungs before it (its last
     solve's verification runs after its time is up) and RESERVE_SHARE of `max_wall_time`, a capped one at most
-    RUNG_SHARE of `max_wall_time`. A safety
-    net runs only where an OMPL rung of its seed found a path."""
+    RUNG_SHARE of `max_wall_time`. A safety net runs only where an OMPL rung of its seed found a path."""
     if not ladder:
         return attempt(None, max_wall_time)
     tried: list[tuple[Rung, Plan]] = []

@@ -267,12 +267,12 @@ search's options but its budgets); the problem is held so that its id is not reu
 def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
                resolution: float, max_checks: int | None = None, max_step: float | None = None) -> OmplPath:
     """Plan start → goal with the named OMPL planner (RRTs extending at most `max_step` rad; None: `default_step`,
-    OMPL_RANGE: OMPL's own) until it stops with an
-    exact path, `planning_time` seconds have passed or (if given) `free` has checked more than `max_checks`
-    configurations, then simplify the path to convergence. A budget in checks repeats on any machine; one in seconds
-    does not. So a search budgeted in checks that stays within a search before it (the same `problem` object and
-    options, a `max_checks` at least the checks that search took) gets the path found then, without searching
-    again (no time; `free` counts the checks it took), if it is among the last FOUND_PATHS found.
+    OMPL_RANGE: OMPL's own) until it stops with an exact path, `planning_time` seconds have passed or (if given)
+    `free` has checked more than `max_checks` configurations, then simplify the path to convergence. A budget in
+    checks repeats on any machine; one in seconds does not. So a search budgeted in checks that stays within a
+    search before it (the same `problem` object and options, a `max_checks` at least the checks that search took)
+    gets the path found then, without searching again (no time; `free` counts the checks it took), if it is among
+    the last FOUND_PATHS found.
 
     A path whose `time_floor` exceeds SLOW_PATH times the problem's longest motion time (time.max) leaves its
     timing little room: the torque, torque-rate and jerk terms make a motion far slower than that floor. Such a
