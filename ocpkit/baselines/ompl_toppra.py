@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from ocpkit.planner.ompl_seed import SeedOptions, hold, ompl_path, ompl_seed, planning_space
+from ocpkit.planner.ompl_seed import MAX_STEP, SeedOptions, hold, ompl_path, ompl_seed, planning_space
 from ocpkit.problem import Problem
 from ocpkit.result import Hints, Plan, finish
 from ocpkit.verify import GEOMETRY_CHECKS
@@ -37,7 +37,7 @@ TOPPRA_HINTS = Hints(
 
 def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
                      resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
-                     max_checks: int | None = None, max_step: float | None = None) -> Plan:
+                     max_checks: int | None = None, max_step: float | None = MAX_STEP) -> Plan:
     """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (the options of
     ocpkit.planner.ompl_seed.SeedOptions: `planner_name` one of OMPL_PLANNERS, `planning_time` s, `seed`,
     `resolution` rad, `grid_points`, `margin` m, `max_checks`, `max_step` rad).
@@ -60,7 +60,7 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
 
 def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
                resolution: float = 0.01, margin: float = 0.01, max_checks: int | None = None,
-               max_step: float | None = None) -> np.ndarray | None:
+               max_step: float | None = MAX_STEP) -> np.ndarray | None:
     """The baseline's simplified collision-free joint-space path (waypoints (k, n), rad) from start to goal, or None
     if the OMPL planner found none within `planning_time` s and `max_checks` configurations checked (options as for
     `plan_ompl_toppra`)."""

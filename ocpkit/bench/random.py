@@ -35,7 +35,6 @@ from ocpkit.geometry.clearances import sphere_centers
 from ocpkit.geometry.scene import Scene, Workspace
 from ocpkit.planner import plan
 from ocpkit.planner.ladder import DEFAULT_LADDER, OMPL_CHECKS, Rung
-from ocpkit.planner.ompl_seed import OMPL_RANGE
 from ocpkit.problem import Problem, TimeBounds
 from ocpkit.result import Plan
 from ocpkit.robots import Robot, load_robot
@@ -80,8 +79,7 @@ def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
 
 def _passable(problem: Problem) -> bool:
     """Whether the room-to-pass certificate's search connects `problem`'s start and goal (module docstring)."""
-    return joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS,
-                      max_step=OMPL_RANGE) is not None
+    return joint_path(problem, planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS, max_step=None) is not None
 
 
 def _obstacles(rng: np.random.Generator, robot: Robot, start: np.ndarray, goal: np.ndarray,

@@ -51,7 +51,7 @@ METHOD = Mapping(
               "dynamics": String(), "guess": String(), "refinements": Number("non-negative", integer=True),
               "max_wall_time": _SECONDS, "single_shot": Choice((True, False)),
               "seed": Number("non-negative", integer=True), "planner_name": String(),
-              "planning_time": _SECONDS, "max_checks": _INTEGER, "max_step": Number("positive", unbounded=True),
+              "planning_time": _SECONDS, "max_checks": _INTEGER, "max_step": Number("positive"),
               "label": String()},
 )
 """One method of the grid: a planner and its options (`label` names it in tables; default: planner + options).

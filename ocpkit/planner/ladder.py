@@ -23,10 +23,7 @@ on the machine's speed; its edges are checked every OMPL_RESOLUTION rad, twice t
 path is only a start, which the solve and the dense verification make exact, and in MBM's cages the search with
 the finer spacing took most of the budget. The search is RRTConnect, and LBKPIECE1 where RRTConnect has found no
 path within a few seconds' checks (OMPL_PLANNER: ocpkit.planner.ompl_seed): in MBM's cages and shelves, and on the
-Fetch, RRTConnect often took hundreds of thousands of checks or the whole budget. An RRT extends at most
-OMPL_STEP rad at a time, not the seed's default (a fraction of the joint box): a shorter step finds a path sooner,
-but the ladder's plans from those paths took longer on MotionBenchMaker's validation split (docs/design-notes.md,
-2026-12-04). More knots resolve what a coarse
+Fetch, RRTConnect often took hundreds of thousands of checks or the whole budget. More knots resolve what a coarse
 grid leaves violated. The
 continuation rung solves the problem relaxed first (a softened margin, wider limits) and the real one from there.
 The last rung is the uncapped single shot with whatever time is left, so the ladder never loses a plan the single
@@ -97,7 +94,6 @@ FIRST_ITERATIONS = 100  # IPOPT iterations per solve of the first rung, from the
 MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
-OMPL_STEP = 1.0  # rad: an OMPL rung's longest RRT extension (the seed's default: ompl_seed.default_step)
 OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.planner.ompl_seed.OMPL_PLANNERS)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 PACE_ITERATIONS = 250  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
@@ -146,7 +142,7 @@ class Rung:
                 guess_options["seed"] = self.seed
             if self.guess == "ompl":
                 guess_options.update(planner_name=OMPL_PLANNER, max_checks=OMPL_CHECKS, planning_time=left,
-                                     resolution=OMPL_RESOLUTION, max_step=OMPL_STEP)
+                                     resolution=OMPL_RESOLUTION)
             changes.update(guess=self.guess, guess_options=guess_options)
         if self.segments is None or options.pseudospectral():
             if self.knots is not None:

@@ -12,18 +12,16 @@ step is one function below, `ompl_seed` runs them in turn:
    joints' coordinates scaled by their velocity limits (`JointSpace`, `time_scale`): OMPL's distances, and so its
    nearest neighbours and shortcuts, count a slow joint's move by the time it takes, not its radians. A straight
    segment is checked, batched, at configurations at most `resolution` rad apart (Euclidean over the joints). An RRT
-   extends at most `max_step` at a time, in OMPL's coordinates: rad of a typical joint. OMPL's own default, a fifth
-   of the joint box's diagonal, is several radians on a 6- or 7-joint arm, and such long extensions into a cage or
-   a shelf mostly fail; by default it is STEP_FRACTION of that diagonal (`default_step`: 0.52 rad on the Panda,
-   1.16 on the UR5, whose joints turn twice as far, 0.59 on the Fetch), which reached the Panda's shelves in a
-   third of the time a 1 rad step took (docs/design-notes.md, 2026-12-04). "rrtconnect-lbkpiece" keeps
-   RRTConnect's paths, the shortest of these before simplification, where it finds one within STAGE_CHECKS
-   configurations checked, and otherwise goes on with LBKPIECE1. That one is lazy: it grows its trees without
-   checking and checks only the edges of a candidate path, so in narrow passages (a shelf, a cage), where most of
-   RRTConnect's extensions collide, it needs far fewer checks. OMPL's PathSimplifier then shortens the path until
-   it stops improving. The last FOUND_PATHS paths found are kept: a search of the same problem object with the same
-   options, budgeted in checks, returns its path again without searching (the simultaneous planner's ladder times
-   the path of its OMPL rung with ompl-topp3: ocpkit.planner.ladder).
+   extends at most `max_step` (MAX_STEP) at a time, in OMPL's coordinates: rad of a typical joint. OMPL's own
+   default, a fifth of the box's diagonal, is several radians on a 6- or 7-joint arm, and such long extensions into
+   a cage or a shelf mostly fail. "rrtconnect-lbkpiece" keeps RRTConnect's paths, the shortest of these before
+   simplification, where it finds one within STAGE_CHECKS configurations checked, and otherwise goes on with
+   LBKPIECE1. That one is lazy: it grows its trees without checking and checks only the edges of a candidate path,
+   so in narrow passages (a shelf, a cage), where most of RRTConnect's extensions collide, it needs far fewer
+   checks. OMPL's PathSimplifier then shortens the path until it stops improving. The last FOUND_PATHS paths found
+   are kept: a search of the same problem object with the same options, budgeted in checks, returns its path again
+   without searching (the simultaneous planner's ladder times the path of its OMPL rung with ompl-topp3:
+   ocpkit.planner.ladder).
 3. `smooth_path`: a cubic spline through the waypoints, parametrised by chord length (rad), with zero
    tangent at both ends, re-checked every resolution/4 rad against half the margin. Where it cuts into an
    obstacle, the midpoints of the straight segments there become waypoints (at most `REPAIR_ROUNDS` rounds).
@@ -58,7 +56,6 @@ OMPL and toppra are optional dependencies, imported on first use (toppra is slow
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Iterator
@@ -85,8 +82,7 @@ STAGE_CHECKS = 50_000
 REPAIR_ROUNDS = 8
 FRICTION_PASSES = 2
 TORQUE_RATE_WINDOW = 1e-3  # s
-STEP_FRACTION = 0.04  # of the joint box's diagonal (OMPL's coordinates): an RRT's longest extension by default
-OMPL_RANGE = math.inf  # as `max_step`: OMPL's own longest extension, a fifth of that diagonal
+MAX_STEP = 1.0  # rad: an RRT's longest extension (OMPL's `range`; module docstring)
 SEGMENT_BATCH = 16  # configurations counted for a segment's first batch; later batches double (`segment_free`)
 FOUND_PATHS = 4  # paths kept for a repeated search (`ompl_path`)
 SLOW_PATH = 0.6  # of the problem's longest motion time: a path whose `time_floor` is longer is searched again
@@ -265,14 +261,13 @@ search's options but its budgets); the problem is held so that its id is not reu
 
 
 def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
-               resolution: float, max_checks: int | None = None, max_step: float | None = None) -> OmplPath:
-    """Plan start → goal with the named OMPL planner (RRTs extending at most `max_step` rad; None: `default_step`,
-    OMPL_RANGE: OMPL's own) until it stops with an exact path, `planning_time` seconds have passed or (if given)
-    `free` has checked more than `max_checks` configurations, then simplify the path to convergence. A budget in
-    checks repeats on any machine; one in seconds does not. So a search budgeted in checks that stays within a
-    search before it (the same `problem` object and options, a `max_checks` at least the checks that search took)
-    gets the path found then, without searching again (no time; `free` counts the checks it took), if it is among
-    the last FOUND_PATHS found.
+               resolution: float, max_checks: int | None = None, max_step: float | None = MAX_STEP) -> OmplPath:
+    """Plan start → goal with the named OMPL planner (RRTs extending at most `max_step` rad) until it stops with an
+    exact path, `planning_time` seconds have passed or (if given) `free` has checked more than `max_checks`
+    configurations, then simplify the path to convergence. A budget in checks repeats on any machine; one in seconds
+    does not. So a search budgeted in checks that stays within a search before it (the same `problem` object and
+    options, a `max_checks` at least the checks that search took) gets the path found then, without searching
+    again (no time; `free` counts the checks it took), if it is among the last FOUND_PATHS found.
 
     A path whose `time_floor` exceeds SLOW_PATH times the problem's longest motion time (time.max) leaves its
     timing little room: the torque, torque-rate and jerk terms make a motion far slower than that floor. Such a
@@ -284,8 +279,8 @@ def ompl_path(problem: Problem, free: FreeSpace, planner_name: str, planning_tim
     the calling thread (RRTConnect, RRT*, BIT*, LBKPIECE1): PRM checks for a solution in a second thread, which
     would deadlock waiting for the interpreter lock that the planning thread holds. A planner of two stages
     (OMPL_PLANNERS) always budgets its first in checks."""
-    if max_step is not None and not max_step > 0:
-        raise OptionError(f"max_step must be a number of radians > 0 (inf: OMPL's own step), got {max_step}")
+    if max_step is not None and not (np.isfinite(max_step) and max_step > 0):
+        raise OptionError(f"max_step must be a finite number of radians > 0, got {max_step}")
     if max_checks is not None and planner_name == "prm":
         raise OptionError("max_checks cannot stop prm (it plans in a second thread); give it a planning_time")
     key = (id(problem), free.margin, planner_name, seed, resolution, max_step)
@@ -344,7 +339,7 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
                 budget = min(free.checks + STAGE_CHECKS, np.inf if max_checks is None else max_checks)
             if stage:
                 setup.clear()  # the planner before this one found no path: start afresh
-            setup.setPlanner(_planner(space.si, name, default_step(problem.robot) if max_step is None else max_step))
+            setup.setPlanner(_planner(space.si, name, max_step))
             setup.solve(_termination(ob, free, max(planning_time - (time.perf_counter() - start), 0.0), budget))
             if setup.haveExactSolutionPath():
                 break
@@ -358,22 +353,15 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
         return OmplPath(waypoints, path_time, time.perf_counter() - start - path_time)
 
 
-def _planner(si: Any, name: str, max_step: float) -> Any:
+def _planner(si: Any, name: str, max_step: float | None) -> Any:
     """OMPL's planner class `name` on `si`; RRTConnect, RRT* and LBKPIECE1 extend at most `max_step` rad at a time
-    (OMPL_RANGE: OMPL's own step)."""
+    (None: OMPL's default step)."""
     import ompl.geometric as og
 
     planner = getattr(og, name)(si)
-    if np.isfinite(max_step) and hasattr(planner, "setRange"):
+    if max_step is not None and hasattr(planner, "setRange"):
         planner.setRange(max_step)
     return planner
-
-
-def default_step(robot: Robot) -> float:
-    """An RRT's longest extension by default (OMPL's coordinates, rad of a typical joint): STEP_FRACTION of the
-    diagonal of the joint box in OMPL's coordinates (`time_scale`), where OMPL's own is a fifth of it (module
-    docstring)."""
-    return STEP_FRACTION * float(np.linalg.norm((robot.q_upper - robot.q_lower) * time_scale(robot)))
 
 
 def no_path_message(planner_name: str, planning_time: float, free: FreeSpace) -> str:
@@ -515,8 +503,7 @@ class SeedOptions:
     clearance if that is smaller (`planning_space`). `max_checks`: OMPL stops after checking this many
     configurations too (a budget that repeats on any machine; planning_time may then be inf; only for the
     planners that plan in the calling thread, not PRM). `max_step` (rad): the longest extension of RRTConnect,
-    RRT* and LBKPIECE1 (OMPL's `range`; BIT* and PRM have none); None: `default_step`, OMPL_RANGE: OMPL's own.
-    `deadline` (a time.perf_counter() value):
+    RRT* and LBKPIECE1 (OMPL's `range`; BIT* and PRM have none); None: OMPL's. `deadline` (a time.perf_counter() value):
     the search also ends then, whatever `planning_time` is left: a planner's budget, which counts the validity
     checker's construction (a second or more on a robot with thousands of sphere pairs) too."""
 
@@ -527,7 +514,7 @@ class SeedOptions:
     grid_points: int = 1000
     margin: float = 0.01
     max_checks: int | None = None
-    max_step: float | None = None
+    max_step: float | None = MAX_STEP
     deadline: float | None = None
 
     def search_time(self) -> float:

@@ -23,8 +23,8 @@ from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, PLANNERS, screening
 from ocpkit.planner.build_cache import Build, Shaped, prepare, shape
 from ocpkit.planner.guesses import STRAIGHT_LINE_RULES
-from ocpkit.planner.ladder import (DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION,
-                                   OMPL_STEP, Rung, climb, ordered)
+from ocpkit.planner.ladder import (DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, Rung,
+                                   climb, ordered)
 from ocpkit.planner.ompl_seed import hold
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
@@ -165,7 +165,7 @@ def _timed_path(problem: Problem, options: SimultaneousOptions, seed: int, max_w
         solver=options.solver, refinements=options.refinements, transcription_options=options.transcription_options,
         solver_options=options.solver_options, dynamics_options=options.dynamics_options,
         max_wall_time=max_wall_time, planner_name=OMPL_PLANNER, planning_time=max_wall_time, seed=seed,
-        resolution=OMPL_RESOLUTION, max_checks=OMPL_CHECKS, max_step=OMPL_STEP)
+        resolution=OMPL_RESOLUTION, max_checks=OMPL_CHECKS)
 
 
 def _screening_start(problem: Problem, options: SimultaneousOptions) -> np.ndarray | None:

@@ -15,9 +15,7 @@ import ocpkit.baselines  # noqa: F401  (registers "ompl-toppra")
 from ocpkit.baselines.ompl_toppra import plan_ompl_toppra
 from ocpkit.errors import OptionError, RegistryError, ScenarioError
 from ocpkit.geometry.clearances import clearances, sphere_centers
-from ocpkit.planner import ompl_seed
-from ocpkit.planner.ompl_seed import (OMPL_RANGE, STEP_FRACTION, FreeSpace, JointSpace, _planner, default_step,
-                                      planning_space, time_scale)
+from ocpkit.planner.ompl_seed import MAX_STEP, FreeSpace, JointSpace, _planner, planning_space
 from ocpkit.tolerances import GEOMETRY_TOLERANCE
 
 
@@ -104,23 +102,13 @@ def test_a_budget_in_checks_stops_the_search_without_a_timer(case1):
 def test_rrts_extend_at_most_max_step_and_a_step_that_is_not_positive_is_named(case1):
     si = JointSpace(case1, planning_space(case1, 0.01), 0.01).si
     assert _planner(si, "RRTConnect", 0.7).getRange() == 0.7
-    assert _planner(si, "RRTstar", 0.3).getRange() == 0.3
+    assert _planner(si, "RRTstar", MAX_STEP).getRange() == MAX_STEP
     assert _planner(si, "LBKPIECE1", 0.7).getRange() == 0.7
-    assert _planner(si, "RRTConnect", OMPL_RANGE).getRange() == 0.0  # OMPL's own, set when the planner is set up
+    assert _planner(si, "RRTConnect", None).getRange() == 0.0  # OMPL's default, set when the planner is set up
     assert not hasattr(_planner(si, "BITstar", 0.7), "getRange")  # BIT* has no step: made as it is
-    for step in (0.0, -1.0, np.nan):
+    for step in (0.0, -1.0, np.inf, np.nan):
         with pytest.raises(OptionError, match="max_step"):
             plan_ompl_toppra(case1, max_step=step)
-
-
-def test_by_default_an_rrt_steps_a_fraction_of_the_joint_boxs_diagonal(case1, monkeypatch):
-    robot = case1.robot
-    diagonal = np.sqrt(np.sum(((robot.q_upper - robot.q_lower) * time_scale(robot)) ** 2))
-    assert default_step(robot) == pytest.approx(STEP_FRACTION * diagonal)
-    steps, made = [], ompl_seed._planner
-    monkeypatch.setattr(ompl_seed, "_planner", lambda si, name, step: steps.append(step) or made(si, name, step))
-    assert plan_ompl_toppra(case1, planning_time=5.0).stats.path.validity_checks > 0
-    assert steps == [pytest.approx(default_step(robot))]
 
 
 @pytest.mark.slow

@@ -23,9 +23,8 @@ from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES, PLANNERS
 from ocpkit.planner.guesses import ompl_guess
 from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NET_KNOTS, NET_SEGMENTS, NO_PATH_HINT,
-                                   OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, OMPL_STEP, PACE_ITERATIONS,
-                                   RESERVE_SHARE, RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered,
-                                   rank)
+                                   OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, PACE_ITERATIONS, RESERVE_SHARE,
+                                   RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import _timed_path, plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow, SolveTiming, Timing
@@ -177,7 +176,7 @@ def test_a_safety_net_searches_as_its_ompl_rung_did_so_it_times_the_path_found(m
     options = SimultaneousOptions()
     _timed_path(CASE2, DEFAULT_LADDER[2].apply(options, 7.0), 0, 7.0)
     searched = DEFAULT_LADDER[1].apply(options, 7.0).guess_options
-    keys = ("planner_name", "seed", "resolution", "max_checks", "max_step")
+    keys = ("planner_name", "seed", "resolution", "max_checks")
     assert {k: given[k] for k in keys} == {k: searched[k] for k in keys}
 
 
@@ -189,7 +188,7 @@ def test_a_rung_overrides_only_what_it_names():
     assert changed == dataclasses.replace(
         options, guess="ompl", guess_options={"fallback": False, "seed": 3, "planner_name": OMPL_PLANNER,
                                               "max_checks": OMPL_CHECKS, "planning_time": 9.0,
-                                              "resolution": OMPL_RESOLUTION, "max_step": OMPL_STEP}, knots=16,
+                                              "resolution": OMPL_RESOLUTION}, knots=16,
         transcription_options={"staged": False, "segments": 2}, solver_options={"tol": 1e-7, "max_iterations": 300},
         iteration_budget=300)
     assert options.knots == 12 and options.solver_options == {"tol": 1e-7}
@@ -207,21 +206,21 @@ def test_a_rung_overrides_only_what_it_names():
                          "guess_options": {"fallback": False, "seed": 0, "planner_name": OMPL_PLANNER,
                                            "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
-                                           "resolution": OMPL_RESOLUTION, "max_step": OMPL_STEP},
+                                           "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300,
                          "pace": PACE_ITERATIONS}),
     (DEFAULT_LADDER[3], {"guess": "ompl", "knots": 6, "transcription_options": {"segments": 3},
                          "guess_options": {"fallback": False, "seed": 1, "planner_name": OMPL_PLANNER,
                                            "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
-                                           "resolution": OMPL_RESOLUTION, "max_step": OMPL_STEP},
+                                           "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300,
                          "pace": PACE_ITERATIONS}),
     (DEFAULT_LADDER[5], {"guess": "ompl", "knots": 16,
                          "guess_options": {"fallback": False, "seed": 2, "planner_name": OMPL_PLANNER,
                                            "max_checks": OMPL_CHECKS,
                                            "planning_time": 7.0,
-                                           "resolution": OMPL_RESOLUTION, "max_step": OMPL_STEP},
+                                           "resolution": OMPL_RESOLUTION},
                          "solver_options": {"max_iterations": 300}, "iteration_budget": 300,
                          "pace": PACE_ITERATIONS}),
     (DEFAULT_LADDER[7], {"relaxed": True, "solver_options": {"max_iterations": 300}, "iteration_budget": 300}),
