@@ -77,6 +77,14 @@ class Verification:
         return not self.skipped and all(c.ok for c in self.checks)
 
     @property
+    def worst_failure(self) -> float:
+        """The largest failed check's worst value (its unit: relative for limits, m for contact), 0 if none failed,
+        inf for a motion that was not verified."""
+        if self.skipped:
+            return np.inf
+        return max((c.worst for c in self.checks if not c.ok), default=0.0)
+
+    @property
     def fixable(self) -> bool:
         """Whether a refinement round has something to fix: a path-constraint violation between check times
         (ocpkit.planner.refinement); a failed dynamics, boundary or consistency check alone is not."""

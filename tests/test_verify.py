@@ -9,7 +9,7 @@ import pytest
 from helpers import REPO, quintic
 
 from ocpkit import load_scenario, verify
-from ocpkit.verify import Verification
+from ocpkit.verify import Check, Verification
 from ocpkit.formats.trajectory import Samples, Trajectory
 
 PROBLEM = load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -143,3 +143,11 @@ def test_a_motion_that_was_not_verified_is_never_ok_and_says_why():
     unverified = Verification.not_run("stopped by time")
     assert not unverified.ok and not unverified.fixable and unverified.checks == ()
     assert unverified.summary() == "not verified: stopped by time"
+
+
+def test_the_worst_failure_is_the_largest_failed_checks_value_and_inf_when_not_verified():
+    checks = (Check("torque", 0.3, 0.01, 0.1, "rel"), Check("obstacle", 0.02, 0.0, 0.2, "m"),
+              Check("velocity", 0.005, 0.01, 0.3, "rel"))  # within its tolerance: not a failure
+    assert Verification(checks, np.zeros(0)).worst_failure == 0.3
+    assert Verification(checks[2:], np.zeros(0)).worst_failure == 0.0
+    assert Verification.not_run("stopped").worst_failure == np.inf

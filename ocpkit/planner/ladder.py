@@ -81,8 +81,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ocpkit.formats.trajectory import Trajectory
 from ocpkit.result import Plan, RungRow
 
@@ -217,9 +215,8 @@ def ordered(ladder: Sequence[Rung], line_buried: bool) -> tuple[Rung, ...]:
 def rank(plan: Plan) -> tuple[int, float]:
     """Sort key of a plan, smaller is better: its status by STATUS_ORDER, then its largest failed check's worst
     value (the check's unit: relative for limits, m for contact; inf for a motion that was not verified)."""
-    worst = np.inf if plan.verification.skipped else \
-        max((c.worst for c in plan.verification.checks if not c.ok), default=0.0)
-    return STATUS_ORDER.index(plan.status) if plan.status in STATUS_ORDER else len(STATUS_ORDER), worst
+    status = STATUS_ORDER.index(plan.status) if plan.status in STATUS_ORDER else len(STATUS_ORDER)
+    return status, plan.verification.worst_failure
 
 
 def climb(attempt: Callable[[Rung | None, float], Plan], ladder: Sequence[Rung], max_wall_time: float) -> Plan:

@@ -39,7 +39,7 @@ RELAXED = Refinement(extra_margin=-0.02, limit_scale=1.5)  # a continuation's fi
 NAMED_PARTS = ("tf", "q", "qd", "qdd", "u", "s", "sd", "sdd")  # parts of w named in out-of-bounds messages
 
 
-UNPACED = "its solve stopped by time, at the pace its rung keeps (ocpkit.planner.ladder)"
+STOPPED_BY_PACE = "its solve stopped by time, at the pace its rung keeps (ocpkit.planner.ladder)"
 """Why a motion is not verified (`paced_out`)."""
 
 CALLBACKS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l", "callback_fun", "total")
@@ -121,7 +121,8 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         iterations += result.iterations
         trajectory = discretization.decode(result.w)
         verified = time.perf_counter()
-        verification = Verification.not_run(UNPACED) if paced_out(result, pace, taken) else verify(problem, trajectory)
+        verification = Verification.not_run(STOPPED_BY_PACE) if paced_out(result, pace, taken) \
+            else verify(problem, trajectory)
         timing.append(round_timing(result, time.perf_counter() - verified))
         following = next_refinement(refinement, verification, trajectory.tf)
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:

@@ -12,7 +12,7 @@ import ocpkit
 from ocpkit.nlp import Refinement
 from ocpkit.planner.build_cache import build
 from ocpkit.planner.refinement import (DEFAULT_ROUNDS, LIMIT_BACKOFF, MIN_MARGIN_STEP, MIN_SHRINK, PENETRATION_FACTOR,
-                                       RELAXED, UNPACED, margin_step, next_refinement, solve_refined)
+                                       RELAXED, STOPPED_BY_PACE, margin_step, next_refinement, solve_refined)
 from ocpkit.solvers import SolverResult, SolverStatus
 from ocpkit.verify import Check, Verification
 
@@ -160,7 +160,7 @@ def test_a_first_solve_stopped_by_time_under_a_pace_is_not_verified(pace, verifi
     assert refined.result.status == SolverStatus.TIME_LIMIT and refined.iterations == 5
     assert bool(calls) == verified and not refined.verification.ok
     assert bool(refined.verification.checks) == verified
-    assert (refined.verification.skipped == UNPACED) != verified
+    assert (refined.verification.skipped == STOPPED_BY_PACE) != verified
 
 
 def test_no_refinement_round_starts_once_the_motion_needs_rows_the_nlp_lacks(monkeypatch):
