@@ -61,11 +61,13 @@ class Check:
 @dataclass(frozen=True)
 class Verification:
     """The result of `verify`: every check, and the sample times where fixable path violations occur; or, for a
-    motion that was not verified (`not_run`), no checks and why not (`skipped`)."""
+    motion that was not verified (`not_run`), no checks and why not (`skipped`); or, for a motion that failed a
+    limit where `verify` was asked to check the limits first, every check but contact (`contact_checked` False)."""
 
     checks: tuple[Check, ...]
     violation_times: np.ndarray  # (k,) seconds, worst first, of path-constraint violations
     skipped: str = ""  # why the motion was not verified; "" when it was
+    contact_checked: bool = True
 
     @classmethod
     def not_run(cls, why: str) -> Verification:
@@ -74,7 +76,7 @@ class Verification:
 
     @property
     def ok(self) -> bool:
-        return not self.skipped and all(c.ok for c in self.checks)
+        return not self.skipped and self.contact_checked and all(c.ok for c in self.checks)
 
     @property
     def worst_failure(self) -> float:
@@ -108,12 +110,16 @@ class Verification:
         failed = [c for c in self.checks if not c.ok]
         if failed:
             return "FAILED " + ", ".join(f"{c.name} {c.worst:+.3g} {c.unit} > {c.tolerance:g} at t={c.time:.3f} s"
-                                         + (f" ({c.where})" if c.where else "") for c in failed)
+                                         + (f" ({c.where})" if c.where else "") for c in failed) \
+                + ("" if self.contact_checked else "; contact not checked")
         return "all pass: " + ", ".join(f"{c.name} {c.worst:+.3g} {c.unit}" for c in self.checks)
 
 
-def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verification:
-    """Re-check `trajectory` against every constraint of `problem` on a dense grid of step dt (s)."""
+def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3, limits_first: bool = False) -> Verification:
+    """Re-check `trajectory` against every constraint of `problem` on a dense grid of step dt (s). With
+    `limits_first`, a motion beyond a position, velocity, torque or torque-rate limit somewhere (a fault a
+    refinement round fixes) is not checked for contact, the costly part for a robot with many spheres: its
+    verification has every other check and `contact_checked` False."""
     outside = _motion_time_outside_bounds(problem, trajectory.tf)
     if outside is not None:
         return Verification((outside,), np.zeros(0))
@@ -127,17 +133,18 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3) -> Verifi
         "torque_rate": (np.abs(samples.taud) / robot.taud_max - 1.0, LIMIT_TOLERANCE, "rel"),
     }
     consistency = np.abs(samples.tau - tau_needed) / (2.0 * robot.tau_max)
+    limits = [_worst(name, v, tolerance, samples.t, unit, robot.joint_names)
+              for name, (v, tolerance, unit) in excess.items()]
+    limits.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))
+    rest = [_boundary(problem, samples), *_consistency(problem, samples)]
+    path_violation = np.max([_per_time(v) - tolerance for v, tolerance, _ in excess.values()], axis=0)
+    if limits_first and path_violation.max() > 0:
+        return Verification((*limits, *rest), _peak_times(samples.t, path_violation), contact_checked=False)
     nearest = smallest_clearances(robot, problem.scene, samples.q)
     penetration = dict(zip(GEOMETRY_CHECKS, (-nearest.self_pairs, -nearest.obstacles, -nearest.workspace)))
-    checks = [_worst(name, v, tolerance, samples.t, unit, robot.joint_names)
-              for name, (v, tolerance, unit) in excess.items()]
-    checks.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))
-    checks += [_worst(name, v, GEOMETRY_TOLERANCE, samples.t, "m") for name, v in penetration.items()]
-    checks.append(_boundary(problem, samples))
-    checks += _consistency(problem, samples)
-    path_violation = np.max([_per_time(v) - tolerance for v, tolerance, _ in excess.values()]
-                            + [_per_time(v) for v in penetration.values()], axis=0)
-    return Verification(tuple(checks), _peak_times(samples.t, path_violation))
+    contact = [_worst(name, v, GEOMETRY_TOLERANCE, samples.t, "m") for name, v in penetration.items()]
+    path_violation = np.max([path_violation, *(_per_time(v) for v in penetration.values())], axis=0)
+    return Verification((*limits, *contact, *rest), _peak_times(samples.t, path_violation))
 
 
 def _motion_time_outside_bounds(problem: Problem, tf: float) -> Check | None:

@@ -9,7 +9,7 @@ import pytest
 from helpers import REPO, quintic
 
 from ocpkit import load_scenario, verify
-from ocpkit.verify import Check, Verification
+from ocpkit.verify import SCALED_LIMITS, Check, Verification
 from ocpkit.formats.trajectory import Samples, Trajectory
 
 PROBLEM = load_scenario(REPO / "scenarios/paper/case2.yaml")
@@ -151,3 +151,20 @@ def test_the_worst_failure_is_the_largest_failed_checks_value_and_inf_when_not_v
     assert Verification(checks, np.zeros(0)).worst_failure == 0.3
     assert Verification(checks[2:], np.zeros(0)).worst_failure == 0.0
     assert Verification.not_run("stopped").worst_failure == np.inf
+
+
+def test_limits_first_leaves_contact_unchecked_only_where_a_limit_is_exceeded():
+    """Too fast and through case 2's obstacle: limits first reports the limits, their violation times and every
+    other check but contact, and is never ok; within the limits it is the full verification."""
+    fast, slow = quintic(PROBLEM, 0.3), quintic(PROBLEM, 4.0)
+    first, full = verify(PROBLEM, fast, limits_first=True), verify(PROBLEM, fast)
+    assert not first.contact_checked and full.contact_checked and not first.ok
+    assert set(by_name(full)) - set(by_name(first)) == {"self_collision", "obstacle", "workspace"}
+    assert all(check == by_name(full)[check.name] for check in first.checks)
+    assert first.fixable and first.penetration == 0.0 and first.limit_excess == full.limit_excess
+    assert first.summary().endswith("; contact not checked")
+    worst_limit = max((c for c in first.checks if c.name in ("position", *SCALED_LIMITS)),
+                      key=lambda c: c.worst - c.tolerance)
+    assert first.violation_times[0] == worst_limit.time  # worst first
+    within = verify(PROBLEM, slow, limits_first=True)
+    assert within.contact_checked and within.checks == verify(PROBLEM, slow).checks and not within.ok

@@ -5,7 +5,10 @@ violation times (newest first), grows the clearance margin by PENETRATION_FACTOR
 least MIN_MARGIN_STEP), shrinks the velocity, torque and torque-rate limits the NLP uses by the excess found plus
 LIMIT_BACKOFF (to no less than MIN_SHRINK of them in one round), and re-solves warm-started from the last
 solution, all through NLP parameters (no rebuild). A check at the worst time alone rarely suffices: with the
-constraint active, the interpolant then dips just beside the new check.
+constraint active, the interpolant then dips just beside the new check. A solve's motion is verified limits
+first (`verify(..., limits_first=True)`): where a limit is exceeded, the round that follows fixes that, and the
+contact check, the costly part on a robot with many spheres, waits for the next motion; the motion a solve
+returns always has its complete verification.
 
 Every solve's w is checked against its variable bounds (slack: `solvers.bound_slack`): an
 iterate outside them (a diverged solver) ends the plan as `failed`, the message naming the variable. All solves
@@ -122,15 +125,18 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         trajectory = discretization.decode(result.w)
         verified = time.perf_counter()
         verification = Verification.not_run(STOPPED_BY_PACE) if paced_out(result, pace, taken) \
-            else verify(problem, trajectory)
-        timing.append(round_timing(result, time.perf_counter() - verified))
+            else verify(problem, trajectory, limits_first=True)
         following = next_refinement(refinement, verification, trajectory.tf)
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
                                          message=f"wall-time limit reached before refinement round {taken + 1}")
         if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds \
                 or iterations >= iteration_budget or (lacking is not None and lacking(trajectory)):
+            if not verification.contact_checked:  # the answer's verification is complete
+                verification = verify(problem, trajectory)
+            timing.append(round_timing(result, time.perf_counter() - verified))
             return Refined(result, trajectory, verification, iterations, taken, tuple(timing))
+        timing.append(round_timing(result, time.perf_counter() - verified))
         refinement, guess, taken = following, discretization.relifted(result.w, following), taken + 1
 
 

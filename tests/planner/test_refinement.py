@@ -147,6 +147,26 @@ class StopsByTime(Converges):
         return SolverResult(result.w, SolverStatus.TIME_LIMIT, self.iterations, 0.0, "stopped")
 
 
+def test_rounds_verify_the_limits_first_and_the_answer_is_verified_in_full(monkeypatch):
+    """Each motion over a limit is refined without its contact check; the motion returned has every check."""
+    asked = []
+    checked = sys.modules["ocpkit.planner.refinement"].verify
+
+    def too_fast_first(problem, trajectory, limits_first=False):
+        asked.append(limits_first)
+        if limits_first:
+            return Verification((Check("velocity", 0.5, 0.01, 0.1, "rel"),), np.array([0.1]), contact_checked=False)
+        return checked(problem, trajectory)
+
+    monkeypatch.setattr(sys.modules["ocpkit.planner.refinement"], "verify", too_fast_first)
+    discretization = build(CASE2, knots=6).discretization
+    solver = Converges(10)
+    refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), rounds=1)
+    assert solver.calls == 2 and refined.rounds == 1 and asked == [True, True, False]
+    assert refined.verification.contact_checked and "obstacle" in {c.name for c in refined.verification.checks}
+    assert len(refined.timing) == 2
+
+
 @pytest.mark.parametrize("pace, verified", [(100, False), (None, True)])
 def test_a_first_solve_stopped_by_time_under_a_pace_is_not_verified(pace, verified, monkeypatch):
     """Its rung hands its time on: a dense verification there would only spend it (the same solve without a
@@ -154,7 +174,7 @@ def test_a_first_solve_stopped_by_time_under_a_pace_is_not_verified(pace, verifi
     calls = []
     checked = sys.modules["ocpkit.planner.refinement"].verify
     monkeypatch.setattr(sys.modules["ocpkit.planner.refinement"], "verify",
-                        lambda *args: calls.append(1) or checked(*args))
+                        lambda *args, **kwargs: calls.append(1) or checked(*args, **kwargs))
     discretization = build(CASE2, knots=6).discretization
     refined = solve_refined(discretization, StopsByTime(5), CASE2, discretization.initial_guess(CASE2), pace=pace)
     assert refined.result.status == SolverStatus.TIME_LIMIT and refined.iterations == 5
