@@ -133,7 +133,7 @@ def time_path(problem: Problem, smooth: PathSpline, transcription: str = "chebys
     else:
         w, start, toppra_tf = discretization.encode(toppra_profile(timed[0])), "from TOPP-RA's profile", \
             float(timed[1][-1])
-    refined = solve_refined(discretization, made.solver, problem, w, refinements, deadline)
+    refined = solve_refined(discretization, made.solver, problem, w, refinements, deadline, limits_first=True)
     return TimedPath(refined, made.setup_time, start, toppra_tf)
 
 

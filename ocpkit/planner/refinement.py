@@ -5,10 +5,12 @@ violation times (newest first), grows the clearance margin by PENETRATION_FACTOR
 least MIN_MARGIN_STEP), shrinks the velocity, torque and torque-rate limits the NLP uses by the excess found plus
 LIMIT_BACKOFF (to no less than MIN_SHRINK of them in one round), and re-solves warm-started from the last
 solution, all through NLP parameters (no rebuild). A check at the worst time alone rarely suffices: with the
-constraint active, the interpolant then dips just beside the new check. A solve's motion is verified limits
-first (`verify(..., limits_first=True)`): where a limit is exceeded, the round that follows fixes that, and the
-contact check, the costly part on a robot with many spheres, waits for the next motion; the motion a solve
-returns always has its complete verification.
+constraint active, the interpolant then dips just beside the new check. An NLP without contact rows (the
+timing of a fixed path: ocpkit.baselines.ompl_topp3) has its rounds' motions verified limits first
+(`limits_first`): no round can change what they touch, so the contact check, the costly part on a robot with
+many spheres, waits for a motion within the limits. Where the NLP has contact rows every motion is verified in
+full, so that one round fixes a limit and a contact found together. The motion returned always has its
+complete verification.
 
 Every solve's w is checked against its variable bounds (slack: `solvers.bound_slack`): an
 iterate outside them (a diverged solver) ends the plan as `failed`, the message naming the variable. All solves
@@ -100,14 +102,16 @@ def paced_out(result: SolverResult, pace: int | None, taken: int) -> bool:
 def solve_refined(discretization: Discretization, solver: PreparedSolver, problem: Problem, guess: np.ndarray,
                   rounds: int = DEFAULT_ROUNDS, deadline: float = np.inf, relaxed: Refinement | None = None,
                   iteration_budget: float = np.inf,
-                  lacking: Callable[[Trajectory], bool] | None = None, pace: int | None = None) -> Refined:
+                  lacking: Callable[[Trajectory], bool] | None = None, pace: int | None = None,
+                  limits_first: bool = False) -> Refined:
     """Solve `problem` on `discretization` from `guess`, verify, and refine for at most `rounds` rounds, all
     before `deadline` (time.perf_counter s); no round starts once the solves have used `iteration_budget`
     iterations, nor once `lacking` says an unverified trajectory needs rows this NLP does not have (screening:
     the caller rebuilds instead). With `relaxed` (continuation), a first solve of the problem
     relaxed so (e.g. RELAXED: wider limits, a softened margin) warm-starts the real one, whatever its status.
     `pace` is the first solve's (PreparedSolver.solve): the rounds after it start near a solution. A first solve
-    stopped by time under a pace is not verified (`paced_out`)."""
+    stopped by time under a pace is not verified (`paced_out`). `limits_first`: the NLP has no contact rows
+    (module docstring)."""
     refinement, iterations, taken, timing = Refinement(), 0, 0, []
     if relaxed is not None:
         bounds = discretization.bounds(problem, relaxed)
@@ -125,7 +129,7 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         trajectory = discretization.decode(result.w)
         verified = time.perf_counter()
         verification = Verification.not_run(STOPPED_BY_PACE) if paced_out(result, pace, taken) \
-            else verify(problem, trajectory, limits_first=True)
+            else verify(problem, trajectory, limits_first=limits_first)
         following = next_refinement(refinement, verification, trajectory.tf)
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,

@@ -265,3 +265,17 @@ def test_retiming_the_simultaneous_plans_own_path_reproduces_its_motion_time(cas
     timed = time_path(problem, PathSpline.fit(chord, q)).refined
     assert timed.verification.ok, timed.verification.summary()
     assert timed.trajectory.tf == pytest.approx(simultaneous.trajectory.tf, rel=0.01)
+
+
+def test_the_timings_rounds_verify_the_limits_first_as_no_round_can_move_the_path(spline, monkeypatch):
+    """The timing OCP has no contact rows: its refinement rounds check contact only on a motion within the limits
+    (ocpkit.planner.refinement), and the motion it returns is verified in full."""
+    import ocpkit.baselines.ompl_topp3 as topp3
+
+    asked = []
+    original = topp3.solve_refined
+    monkeypatch.setattr(topp3, "solve_refined",
+                        lambda *args, **kwargs: asked.append(kwargs) or original(*args, **kwargs))
+    timed = topp3.time_path(CASE1, spline[0]).refined
+    assert [kwargs.get("limits_first") for kwargs in asked] == [True]
+    assert timed.verification.contact_checked and "obstacle" in {c.name for c in timed.verification.checks}

@@ -148,7 +148,8 @@ class StopsByTime(Converges):
 
 
 def test_rounds_verify_the_limits_first_and_the_answer_is_verified_in_full(monkeypatch):
-    """Each motion over a limit is refined without its contact check; the motion returned has every check."""
+    """Without contact rows, each motion over a limit is refined without its contact check; the motion returned
+    has every check. With them (the default), every motion is verified in full."""
     asked = []
     checked = sys.modules["ocpkit.planner.refinement"].verify
 
@@ -161,10 +162,14 @@ def test_rounds_verify_the_limits_first_and_the_answer_is_verified_in_full(monke
     monkeypatch.setattr(sys.modules["ocpkit.planner.refinement"], "verify", too_fast_first)
     discretization = build(CASE2, knots=6).discretization
     solver = Converges(10)
-    refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), rounds=1)
+    refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), rounds=1,
+                            limits_first=True)
     assert solver.calls == 2 and refined.rounds == 1 and asked == [True, True, False]
     assert refined.verification.contact_checked and "obstacle" in {c.name for c in refined.verification.checks}
     assert len(refined.timing) == 2
+    asked.clear()
+    solve_refined(discretization, Converges(10), CASE2, discretization.initial_guess(CASE2), rounds=1)
+    assert asked == [False, False]
 
 
 @pytest.mark.parametrize("pace, verified", [(100, False), (None, True)])
