@@ -5,12 +5,13 @@ violation times (newest first), grows the clearance margin by PENETRATION_FACTOR
 least MIN_MARGIN_STEP), shrinks the velocity, torque and torque-rate limits the NLP uses by the excess found plus
 LIMIT_BACKOFF (to no less than MIN_SHRINK of them in one round), and re-solves warm-started from the last
 solution, all through NLP parameters (no rebuild). A check at the worst time alone rarely suffices: with the
-constraint active, the interpolant then dips just beside the new check. An NLP without contact rows (the
-timing of a fixed path: ocpkit.baselines.ompl_topp3) has its rounds' motions verified limits first
-(`limits_first`): no round can change what they touch, so the contact check, the costly part on a robot with
-many spheres, waits for a motion within the limits. Where the NLP has contact rows every motion is verified in
-full, so that one round fixes a limit and a contact found together. The motion returned always has its
-complete verification.
+constraint active, the interpolant then dips just beside the new check.
+
+An NLP without contact rows (the timing of a fixed path: ocpkit.baselines.ompl_topp3) has its rounds' motions
+verified limits first (`limits_first`): no round can change what they touch, so the contact check, the costly
+part on a robot with many spheres, waits for a motion within the limits, and a contact found then ends the
+rounds. Where the NLP has contact rows every motion is verified in full, so that one round fixes a limit and a
+contact found together. The motion returned always has its complete verification.
 
 Every solve's w is checked against its variable bounds (slack: `solvers.bound_slack`): an
 iterate outside them (a diverged solver) ends the plan as `failed`, the message naming the variable. All solves
@@ -130,7 +131,8 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         verified = time.perf_counter()
         verification = Verification.not_run(STOPPED_BY_PACE) if paced_out(result, pace, taken) \
             else verify(problem, trajectory, limits_first=limits_first)
-        following = next_refinement(refinement, verification, trajectory.tf)
+        following = None if limits_first and verification.contact_checked \
+            else next_refinement(refinement, verification, trajectory.tf)  # within the limits: nothing to fix
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
                                          message=f"wall-time limit reached before refinement round {taken + 1}")

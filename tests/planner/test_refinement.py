@@ -172,6 +172,18 @@ def test_rounds_verify_the_limits_first_and_the_answer_is_verified_in_full(monke
     assert asked == [False, False]
 
 
+def test_without_contact_rows_a_contact_ends_the_rounds_no_round_could_fix_it():
+    """Case 2's straight line, within its limits, runs through the obstacle: with contact rows a round follows,
+    without them (limits first) none does."""
+    discretization = build(CASE2, knots=6).discretization
+    for limits_first, solves in ((False, 2), (True, 1)):
+        solver = Converges(10)
+        refined = solve_refined(discretization, solver, CASE2, discretization.initial_guess(CASE2), rounds=1,
+                                limits_first=limits_first)
+        checks = {c.name: c for c in refined.verification.checks}
+        assert solver.calls == solves and checks["velocity"].ok and not checks["obstacle"].ok
+
+
 @pytest.mark.parametrize("pace, verified", [(100, False), (None, True)])
 def test_a_first_solve_stopped_by_time_under_a_pace_is_not_verified(pace, verified, monkeypatch):
     """Its rung hands its time on: a dense verification there would only spend it (the same solve without a
