@@ -135,16 +135,17 @@ def verify(problem: Problem, trajectory: Trajectory, dt: float = 1e-3, limits_fi
     consistency = np.abs(samples.tau - tau_needed) / (2.0 * robot.tau_max)
     limits = [_worst(name, v, tolerance, samples.t, unit, robot.joint_names)
               for name, (v, tolerance, unit) in excess.items()]
-    limits.append(_worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel"))
+    dynamics = _worst("dynamics", consistency, DYNAMICS_TOLERANCE, samples.t, "rel")
     rest = [_boundary(problem, samples), *_consistency(problem, samples)]
     path_violation = np.max([_per_time(v) - tolerance for v, tolerance, _ in excess.values()], axis=0)
     if limits_first and path_violation.max() > 0:
-        return Verification((*limits, *rest), _peak_times(samples.t, path_violation), contact_checked=False)
+        return Verification((*limits, dynamics, *rest), _peak_times(samples.t, path_violation),
+                            contact_checked=False)
     nearest = smallest_clearances(robot, problem.scene, samples.q)
     penetration = dict(zip(GEOMETRY_CHECKS, (-nearest.self_pairs, -nearest.obstacles, -nearest.workspace)))
     contact = [_worst(name, v, GEOMETRY_TOLERANCE, samples.t, "m") for name, v in penetration.items()]
     path_violation = np.max([path_violation, *(_per_time(v) for v in penetration.values())], axis=0)
-    return Verification((*limits, *contact, *rest), _peak_times(samples.t, path_violation))
+    return Verification((*limits, dynamics, *contact, *rest), _peak_times(samples.t, path_violation))
 
 
 def _motion_time_outside_bounds(problem: Problem, tf: float) -> Check | None:

@@ -131,8 +131,9 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         verified = time.perf_counter()
         verification = Verification.not_run(STOPPED_BY_PACE) if paced_out(result, pace, taken) \
             else verify(problem, trajectory, limits_first=limits_first)
+        # without contact rows, a motion verified in full is within the limits: what else fails, no round fixes
         following = None if limits_first and verification.contact_checked \
-            else next_refinement(refinement, verification, trajectory.tf)  # within the limits: nothing to fix
+            else next_refinement(refinement, verification, trajectory.tf)
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
                                          message=f"wall-time limit reached before refinement round {taken + 1}")
