@@ -67,7 +67,7 @@ class Verification:
     checks: tuple[Check, ...]
     violation_times: np.ndarray  # (k,) seconds, worst first, of path-constraint violations
     skipped: str = ""  # why the motion was not verified; "" when it was
-    contact_checked: bool = True
+    contact_checked: bool = True  # False only where `verify` checked the limits first and found one exceeded
 
     @classmethod
     def not_run(cls, why: str) -> Verification:

@@ -137,13 +137,13 @@ def solve_refined(discretization: Discretization, solver: PreparedSolver, proble
         if following is not None and result.status == SolverStatus.CONVERGED and time.perf_counter() > deadline:
             result = dataclasses.replace(result, status=SolverStatus.TIME_LIMIT,
                                          message=f"wall-time limit reached before refinement round {taken + 1}")
-        if following is None or result.status != SolverStatus.CONVERGED or taken >= rounds \
-                or iterations >= iteration_budget or (lacking is not None and lacking(trajectory)):
-            if not verification.contact_checked:  # the answer's verification is complete
-                verification = verify(problem, trajectory)
-            timing.append(round_timing(result, time.perf_counter() - verified))
-            return Refined(result, trajectory, verification, iterations, taken, tuple(timing))
+        last = following is None or result.status != SolverStatus.CONVERGED or taken >= rounds \
+            or iterations >= iteration_budget or (lacking is not None and lacking(trajectory))
+        if last and not verification.contact_checked:  # the answer's verification is complete
+            verification = verify(problem, trajectory)
         timing.append(round_timing(result, time.perf_counter() - verified))
+        if last:
+            return Refined(result, trajectory, verification, iterations, taken, tuple(timing))
         refinement, guess, taken = following, discretization.relifted(result.w, following), taken + 1
 
 
