@@ -179,6 +179,11 @@ def _seed_ompl(util: Any, seed: int) -> None:
         util.RNG.setSeed(seed + 1)
 
 
+def configuration(state: Any, scale: np.ndarray) -> np.ndarray:
+    """The configuration (n,) rad of an OMPL state whose coordinates are q × `scale` (n,) (`time_scale`)."""
+    return np.array(state[0:len(scale)]) / scale
+
+
 class JointSpace:
     """OMPL's space information over the joints, in time-scaled coordinates: OMPL's coordinate i is q_i × `scale`_i
     (`time_scale`). The joint limits are its bounds, `free` its state validity checker, and a straight segment is
@@ -194,19 +199,21 @@ class JointSpace:
         space.setBounds(bounds)
         self.si = ob.SpaceInformation(space)
         self.lower, self.upper = robot.q_lower, robot.q_upper
-        q = self.q
+        scale = self.scale  # the checkers hold the scale, not this object: through a bound method they would tie it
+        # and the space information that holds them into a cycle no collector frees (nanobind then reports the
+        # OMPL objects as leaked when Python exits)
 
         class SegmentValidator(ob.MotionValidator):
             def checkMotion(self, a: Any, b: Any) -> bool:  # OMPL's name
-                return free.segment_free(q(a), q(b), resolution)
+                return free.segment_free(configuration(a, scale), configuration(b, scale), resolution)
 
-        self.si.setStateValidityChecker(lambda state: bool(free.free(q(state)[None])[0]))
+        self.si.setStateValidityChecker(lambda state: bool(free.free(configuration(state, scale)[None])[0]))
         self.si.setMotionValidator(SegmentValidator(self.si))
         self.si.setup()
 
     def q(self, state: Any) -> np.ndarray:
         """The configuration (n,) rad of an OMPL state."""
-        return np.array(state[0:len(self.scale)]) / self.scale
+        return configuration(state, self.scale)
 
     def state(self, q: np.ndarray) -> Any:
         """A new OMPL state holding q (n,), clipped into the joint limits (scenario files allow 1e-9 rad of

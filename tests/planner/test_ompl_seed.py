@@ -4,8 +4,10 @@ simultaneous planner's "ompl" guess (slowed, on the NLP grid) made from it witho
 from __future__ import annotations
 
 import dataclasses
+import gc
 import importlib
 import time
+import weakref
 from types import SimpleNamespace
 
 import numpy as np
@@ -197,6 +199,16 @@ def test_ompl_counts_a_slow_joints_move_by_its_time_and_its_paths_end_exactly_at
     found = ompl_seed_module.ompl_path(case1, ompl_seed_module.planning_space(case1, 0.01), "rrtconnect", 5.0, 7,
                                        0.02, max_checks=10**6)
     np.testing.assert_array_equal(found.waypoints[[0, -1]], [case1.start, case1.goal])
+
+
+def test_a_joint_space_is_freed_once_dropped_so_no_ompl_object_outlives_its_search(case1):
+    space = ompl_seed_module.JointSpace(case1, ompl_seed_module.planning_space(case1, 0.01), 0.02)
+    checker = space.si.getStateValidityChecker()
+    assert checker.isValid(space.state(case1.start))  # its checkers work ...
+    alive = weakref.ref(space)
+    del space, checker
+    gc.collect()
+    assert alive() is None  # ... and do not hold it: a cycle through OMPL's objects would keep it (and them)
 
 
 def test_a_robot_without_slow_joints_plans_in_radians():
