@@ -179,7 +179,7 @@ def _seed_ompl(util: Any, seed: int) -> None:
         util.RNG.setSeed(seed + 1)
 
 
-def configuration(state: Any, scale: np.ndarray) -> np.ndarray:
+def _configuration(state: Any, scale: np.ndarray) -> np.ndarray:
     """The configuration (n,) rad of an OMPL state whose coordinates are q × `scale` (n,) (`time_scale`)."""
     return np.array(state[0:len(scale)]) / scale
 
@@ -199,21 +199,19 @@ class JointSpace:
         space.setBounds(bounds)
         self.si = ob.SpaceInformation(space)
         self.lower, self.upper = robot.q_lower, robot.q_upper
-        scale = self.scale  # the checkers hold the scale, not this object: through a bound method they would tie it
-        # and the space information that holds them into a cycle no collector frees (nanobind then reports the
-        # OMPL objects as leaked when Python exits)
+        scale = self.scale  # not self.q: a bound method would close a cycle through OMPL's objects, never freed
 
         class SegmentValidator(ob.MotionValidator):
             def checkMotion(self, a: Any, b: Any) -> bool:  # OMPL's name
-                return free.segment_free(configuration(a, scale), configuration(b, scale), resolution)
+                return free.segment_free(_configuration(a, scale), _configuration(b, scale), resolution)
 
-        self.si.setStateValidityChecker(lambda state: bool(free.free(configuration(state, scale)[None])[0]))
+        self.si.setStateValidityChecker(lambda state: bool(free.free(_configuration(state, scale)[None])[0]))
         self.si.setMotionValidator(SegmentValidator(self.si))
         self.si.setup()
 
     def q(self, state: Any) -> np.ndarray:
         """The configuration (n,) rad of an OMPL state."""
-        return configuration(state, self.scale)
+        return _configuration(state, self.scale)
 
     def state(self, q: np.ndarray) -> Any:
         """A new OMPL state holding q (n,), clipped into the joint limits (scenario files allow 1e-9 rad of
