@@ -4,8 +4,9 @@ first path, with the planner's own validity test (ocpkit.planner.ompl_seed.plann
 Run from the repository root:  .venv/bin/python scripts/ompl_checks.py DIR [--robot panda] [--problems 1 10]
 [--planner rrtconnect-lbkpiece] (another of ocpkit.planner.ompl_seed.OMPL_PLANNERS: the ladder's OMPL rungs search
 with rrtconnect-lbkpiece). DIR is the folder `ocpkit data mbm --dir DIR` filled. Prints, per scene and over all
-problems, the median configurations checked per second during the search, the median search time and how many
-searches found a path within --planning-time seconds; all measured in this one run.
+problems, the median configurations checked per second during the search (its checks over its time: the path's
+simplification, which checks its shortcuts, is timed and counted apart), the median search time, the median
+simplification time and how many searches found a path within --planning-time seconds; all measured in this one run.
 """
 
 from __future__ import annotations
@@ -19,14 +20,15 @@ from ocpkit.formats.mbm import SCENES
 from ocpkit.planner.ompl_seed import OMPL_PLANNERS, SeedOptions, ompl_path, planning_space
 
 
-def search(path: Path, planning_time: float, planner_name: str) -> tuple[float, float, bool]:
-    """(configurations checked per second, search seconds, path found) of one search."""
+def search(path: Path, planning_time: float, planner_name: str) -> tuple[float, float, float, bool]:
+    """(configurations checked per second by the search, search seconds, simplification seconds, path found) of one
+    search."""
     problem = ocpkit.load_scenario(path)
     options = SeedOptions(planner_name=planner_name, planning_time=planning_time)
     free = planning_space(problem, options.margin)
     found = ompl_path(problem, free, options.planner_name, planning_time, options.seed, options.resolution,
                       max_step=options.max_step)
-    return free.checks / found.path_time, found.path_time, found.waypoints is not None
+    return found.search_checks / found.path_time, found.path_time, found.simplify_time, found.waypoints is not None
 
 
 def main() -> None:
@@ -37,17 +39,20 @@ def main() -> None:
     parser.add_argument("--planning-time", type=float, default=10.0)
     parser.add_argument("--planner", default="rrtconnect", choices=sorted(OMPL_PLANNERS))
     args = parser.parse_args()
-    rates, times, found = [], [], 0
-    print(f"{'scene':18} {'checks/s':>10} {'search s':>9} {'found':>6}")
+    print(f"{'scene':18} {'checks/s':>10} {'search s':>9} {'simplify s':>11} {'found':>6}")
+    every = []
     for scene in SCENES:
         rows = [search(args.directory / args.robot / scene / f"{k:04d}.yaml", args.planning_time, args.planner)
                 for k in range(args.problems[0], args.problems[1] + 1)]
-        rates += [r for r, _, _ in rows]
-        times += [t for _, t, _ in rows]
-        found += sum(f for _, _, f in rows)
-        print(f"{scene:18} {statistics.median(r for r, _, _ in rows):10.0f} "
-              f"{statistics.median(t for _, t, _ in rows):9.3f} {sum(f for _, _, f in rows):3d}/{len(rows)}")
-    print(f"{'all':18} {statistics.median(rates):10.0f} {statistics.median(times):9.3f} {found:3d}/{len(rates)}")
+        every += rows
+        print(_row(scene, rows))
+    print(_row("all", every))
+
+
+def _row(name: str, rows: list[tuple[float, float, float, bool]]) -> str:
+    """A table row: the medians of the rates and times of `rows` (`search`) and how many found a path."""
+    rate, search_time, simplify_time = (statistics.median(column) for column in list(zip(*rows))[:3])
+    return f"{name:18} {rate:10.0f} {search_time:9.3f} {simplify_time:11.3f} {sum(r[3] for r in rows):3d}/{len(rows)}"
 
 
 if __name__ == "__main__":

@@ -244,13 +244,15 @@ def _termination(ob: Any, free: FreeSpace, planning_time: float, max_checks: int
 
 @dataclass(frozen=True)
 class OmplPath:
-    """Simplified waypoints (k, n) from start to goal, or None without an exact path; times in seconds, summed over
-    the `searches` made (`ompl_path`)."""
+    """Simplified waypoints (k, n) from start to goal, or None without an exact path; times in seconds and
+    `search_checks` (the configurations the searches checked, not the simplifications) summed over the `searches`
+    made (`ompl_path`)."""
 
     waypoints: np.ndarray | None
     path_time: float
     simplify_time: float
     searches: int = 1
+    search_checks: int = 0
 
 
 def time_floor(robot: Robot, waypoints: np.ndarray) -> float:
@@ -321,7 +323,7 @@ def _faster(robot: Robot, first: OmplPath, then: OmplPath) -> OmplPath:
     kept = first if then.waypoints is None or time_floor(robot, first.waypoints) <= time_floor(robot, then.waypoints) \
         else then
     return OmplPath(kept.waypoints, first.path_time + then.path_time, first.simplify_time + then.simplify_time,
-                    first.searches + then.searches)
+                    first.searches + then.searches, first.search_checks + then.search_checks)
 
 
 def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time: float, seed: int,
@@ -336,7 +338,7 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
         space = JointSpace(problem, free, resolution)
         setup = og.SimpleSetup(space.si)
         setup.setStartAndGoalStates(space.state(problem.start), space.state(problem.goal))
-        start = time.perf_counter()
+        start, before = time.perf_counter(), free.checks
         stages = OMPL_PLANNERS[planner_name]
         for stage, name in enumerate(stages):
             budget = max_checks
@@ -348,14 +350,14 @@ def _search(problem: Problem, free: FreeSpace, planner_name: str, planning_time:
             setup.solve(_termination(ob, free, max(planning_time - (time.perf_counter() - start), 0.0), budget))
             if setup.haveExactSolutionPath():
                 break
-        path_time = time.perf_counter() - start
+        path_time, searched = time.perf_counter() - start, free.checks - before
         if not setup.haveExactSolutionPath():
-            return OmplPath(None, path_time, 0.0)
+            return OmplPath(None, path_time, 0.0, search_checks=searched)
         path = og.PathGeometric(setup.getSolutionPath())
         og.PathSimplifier(space.si).simplifyMax(path)
         waypoints = np.array([space.q(state) for state in path.getStates()])
         waypoints[[0, -1]] = np.clip([problem.start, problem.goal], space.lower, space.upper)  # not rounded by scale
-        return OmplPath(waypoints, path_time, time.perf_counter() - start - path_time)
+        return OmplPath(waypoints, path_time, time.perf_counter() - start - path_time, search_checks=searched)
 
 
 def _planner(si: Any, name: str, max_step: float | None) -> Any:

@@ -142,6 +142,18 @@ def test_a_repeated_search_reuses_the_path_found_with_its_checks(case1):
     np.testing.assert_array_equal(fresh.waypoints, first.waypoints)  # the same seed finds the same path
 
 
+def test_a_search_counts_its_own_checks_apart_from_the_simplification(case1, monkeypatch):
+    import ompl.geometric as og
+
+    free = ompl_seed_module.planning_space(case1, 0.01)
+    found = ompl_seed_module.ompl_path(case1, free, "rrtconnect", 5.0, 6, 0.02)
+    monkeypatch.setattr(og.PathSimplifier, "simplifyMax", lambda _simplifier, _path: False)  # checks nothing
+    other = dataclasses.replace(case1)  # another object: searched again, with the same seed
+    bare_free = ompl_seed_module.planning_space(other, 0.01)
+    bare = ompl_seed_module.ompl_path(other, bare_free, "rrtconnect", 5.0, 6, 0.02)
+    assert bare.search_checks == bare_free.checks == found.search_checks < free.checks
+
+
 def test_a_search_budgeted_in_time_or_in_fewer_checks_than_the_path_took_searches_again(case1):
     free = ompl_seed_module.planning_space(case1, 0.01)
     found = ompl_seed_module.ompl_path(case1, free, "rrtconnect", 5.0, 5, 0.02, max_checks=10**6)
