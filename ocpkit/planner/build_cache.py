@@ -36,7 +36,9 @@ from ocpkit.registry import construct
 from ocpkit.solvers import SOLVERS, PreparedSolver
 from ocpkit.solvers.base import STAGES_NEEDED, Solver
 from ocpkit.solvers.compiled import compile_seconds
+from ocpkit.solvers.pointwise import forget_made
 from ocpkit.transcription import TRANSCRIPTIONS, Discretization
+from ocpkit.transcription.assembly import forget_defects
 from ocpkit.transcription.ocp import OCP
 
 MEMORY_BUDGET = 2 * 1024**3
@@ -169,8 +171,11 @@ def _staged_for(solver: str, solver_options: dict, transcription: str, transcrip
 
 
 def clear_builds() -> None:
-    """Forget every cached build and hand the memory back to the operating system."""
+    """Forget every cached build, and the parts kept for later builds (the dynamics rows' Functions, their
+    derivatives and compiled code), and hand the memory back to the operating system."""
     _BUILDS.clear()
+    forget_defects()
+    forget_made()
     _release()
 
 

@@ -31,12 +31,22 @@ path-timing OCP's jerk in its objective) take the SX graph.
 
 from __future__ import annotations
 
+import functools
+from collections import OrderedDict
+from collections.abc import Callable
+from typing import Any, TypeVar
+
 import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
 from ocpkit.nlp import NLP, PointCall
-from ocpkit.solvers.compiled import compiled
+from ocpkit.solvers.compiled import cache_directory, compiled, compiler
+
+T = TypeVar("T")
+MADE_KEPT = 16
+"""Point derivatives and compiled code kept for reuse (`_made_once`)."""
+_MADE: OrderedDict[tuple, tuple[tuple[ca.Function, ...], Any]] = OrderedDict()
 
 ROWS_AT_ONCE = 6
 """The other rows are differentiated this many consecutive rows at a time: rows added together read the same few
@@ -146,10 +156,16 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
     derivatives, marked = [], []
     for calls in groups.values():
         names = (f"jac_{len(marked)}", f"hess_{len(marked)}")  # the compiled ones named alike for every problem
-        derivatives.append(_point_nonzeros(calls[0][0].function, len(calls[0][0].inputs), names))
+        function, differentiated = calls[0][0].function, len(calls[0][0].inputs)
+        make = functools.partial(_point_nonzeros, function, differentiated, names)
         if compile and all(call.compiled for call, _ in calls):
-            marked.append(len(derivatives) - 1)
-    loaded = compiled([f for k in marked for f, _ in derivatives[k]]) if marked else None
+            marked.append(len(derivatives))
+            derivatives.append(_made_once((function,), (differentiated, names), make))
+        else:
+            derivatives.append(make())
+    to_compile = tuple(f for k in marked for f, _ in derivatives[k])
+    where = ("compiled", str(cache_directory()), compiler())  # the library depends on both
+    loaded = _made_once(to_compile, where, lambda: compiled(to_compile)) if marked else None
     for k, pair in zip(marked, zip(loaded[0::2], loaded[1::2]) if loaded else ()):
         derivatives[k] = [(f, sparsity) for f, (_, sparsity) in zip(pair, derivatives[k])]
     jacobians, hessians, jacobian_places, hessian_places = [], [], [], []
@@ -185,6 +201,25 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
                                                                                              ca.MX(n_x, n_x)))
     return (ca.Function("mapped_jacobian", [X, P], [jac]),
             ca.Function("mapped_hessian", [X, P, lam_f, lam_g], [hess]))
+
+
+def _made_once(functions: tuple[ca.Function, ...], key: tuple, make: Callable[[], T]) -> T:
+    """make()'s value, made once for these Function objects and `key` while they are among the MADE_KEPT most
+    recently used: the dynamics rows' point Function is one object for every NLP of a robot and OCP
+    (ocpkit.transcription.assembly), so its derivatives and their compiled code are built once. The entry holds
+    the Functions, so no other object takes their ids while it lasts."""
+    entry = (*map(id, functions), *key)
+    if entry not in _MADE:
+        _MADE[entry] = functions, make()
+        while len(_MADE) > MADE_KEPT:
+            _MADE.popitem(last=False)
+    _MADE.move_to_end(entry)
+    return _MADE[entry][1]
+
+
+def forget_made() -> None:
+    """Forget the point derivatives and compiled code kept for reuse (`_made_once`)."""
+    _MADE.clear()
 
 
 def _mapped_arguments(calls: list[PointCall], x: ca.SX, p: ca.SX) -> ca.Function:

@@ -26,6 +26,7 @@ against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP 
 from __future__ import annotations
 
 import dataclasses
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 
 import casadi as ca
@@ -37,7 +38,11 @@ from ocpkit.nlp import NLP, Layout, PointCall, Stages
 from ocpkit.problem import Problem
 from ocpkit.transcription.ocp import OCP, Node, RobotOCP
 
-__all__ = ["Assembly", "Node"]
+__all__ = ["Assembly", "Node", "forget_defects"]
+
+DEFECTS_KEPT = 16
+"""The OCP's defect Functions kept for reuse (`_defect_function`): one per dynamics backend and OCP in use."""
+_DEFECTS: OrderedDict[tuple, ca.Function] = OrderedDict()
 
 
 class Assembly:
@@ -64,6 +69,7 @@ class Assembly:
         self.objective_call: PointCall | None = None
         self.g: list[ca.SX] = []
         self.lbg: list[np.ndarray] = []
+        self.row_count = 0  # rows added so far
         self.ubg: list[np.ndarray] = []
 
     # -- variables -----------------------------------------------------------------------------------
@@ -83,13 +89,9 @@ class Assembly:
         self.w.name("goal", X[goal, :self.ocp.ends])
 
     # -- rows ----------------------------------------------------------------------------------------
-    @property
-    def row_count(self) -> int:
-        """Rows added so far."""
-        return sum(len(lower) for lower in self.lbg)
-
     def add(self, rows: Rows) -> None:
         """The rows lower ≤ g ≤ upper (bounds broadcast to g's length)."""
+        self.row_count += rows.g.numel()
         self.g.append(rows.g)
         self.lbg.append(np.broadcast_to(rows.lower, (rows.g.numel(),)))
         self.ubg.append(np.broadcast_to(rows.upper, (rows.g.numel(),)))
@@ -106,11 +108,24 @@ class Assembly:
         values = self.ocp.join(x)
         parts = tuple(values[columns] for columns in self.ocp.part_slices().values())  # the Function's inputs
         if self._defect is None:
-            symbols = _symbols_like(parts)
-            self._defect = ca.Function("defect", [*symbols, *self._ocp_parameters],
-                                       [self.ocp.defect(self.dynamics, self.ocp.split(ca.vertcat(*symbols)))])
+            self._defect = self._defect_function(parts)
         if self._defect.numel_out(0):
             self._call(self._defect, parts, self._ocp_parameters, 0.0, 0.0, compiled=True)
+
+    def _defect_function(self, parts: tuple[ca.SX, ...]) -> ca.Function:
+        """The Function (the node's parts, the OCP's parameters) → the OCP's defect: the same object for every
+        NLP of the same dynamics backend and OCP (their keys), so the derivatives built for it, and their compiled
+        code, are reused with it (ocpkit.solvers.pointwise), and its graph is made once."""
+        key = (self.dynamics and self.dynamics.key, type(self.ocp), self.ocp.key, tuple(p.shape for p in parts),
+               tuple(p.shape for p in self._ocp_parameters))
+        if key not in _DEFECTS:
+            symbols = _symbols_like(parts)
+            _DEFECTS[key] = ca.Function("defect", [*symbols, *self._ocp_parameters],
+                                        [self.ocp.defect(self.dynamics, self.ocp.split(ca.vertcat(*symbols)))])
+            while len(_DEFECTS) > DEFECTS_KEPT:
+                _DEFECTS.popitem(last=False)
+        _DEFECTS.move_to_end(key)
+        return _DEFECTS[key]
 
     def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX) -> ca.SX:
         """The OCP's running-cost inputs at a point at time t where the controls have slope du/dσ = `du_ds`."""
@@ -187,6 +202,11 @@ class Assembly:
         return NLP(fields["x"], fields["p"], fields["f"], fields["g"], np.concatenate(self.lbg),
                    np.concatenate(self.ubg), self.w, self.p, shape_key, fields.get("exact_hessian", True), stages,
                    tuple(self.point_calls) if unchanged else (), self.objective_call if unchanged else None)
+
+
+def forget_defects() -> None:
+    """Forget the defect Functions kept for reuse (`Assembly._defect_function`)."""
+    _DEFECTS.clear()
 
 
 def _point_fields(values: PointValues) -> tuple:

@@ -20,7 +20,7 @@ from ocpkit.geometry.scene import Boxes, Cylinders
 from ocpkit.path_spline import PathSpline
 from ocpkit.nlp import Refinement
 from ocpkit.planner import screening
-from ocpkit.solvers.pointwise import _input_map, pointwise_derivatives
+from ocpkit.solvers.pointwise import _input_map, forget_made, pointwise_derivatives
 from ocpkit.transcription import TRANSCRIPTIONS
 from ocpkit.transcription.ocp import PathTimingOCP
 
@@ -118,6 +118,7 @@ def test_a_damaged_library_falls_back_to_the_graphs_with_a_warning(tmp_path, mon
     monkeypatch.setenv("OCPKIT_COMPILED_DIR", str(tmp_path))
     monkeypatch.setattr(compiled_module, "_warned", set())
     _assert_same_derivatives(_discretization("chebyshev", {"knots": 6}), PROBLEM)
+    forget_made()  # the code loaded is kept for later builds: let it go, and load it again
     for library in tmp_path.glob("*.so"):
         library.write_bytes(b"not a shared library")
     with pytest.warns(UserWarning, match="cannot load"):
