@@ -62,6 +62,9 @@ class Build:
 
 
 _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
+LAYOUTS_KEPT = 8
+"""Discretizations without constraints kept for reuse (`layout`)."""
+_LAYOUTS: OrderedDict[tuple, Discretization] = OrderedDict()
 
 
 @dataclass(frozen=True)
@@ -106,9 +109,27 @@ def shape(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
     key = (method.shape_key(backend, plugins, ocp), solver, frozen(options))
     if key in _BUILDS:
         return Shaped(_BUILDS[key].discretization, key, nlp_solver, _BUILDS[key], 0.0, 0)
+    if not plugins and key in _LAYOUTS:
+        return Shaped(_LAYOUTS[key], key, nlp_solver, None, 0.0, _resident())
     began, resident = time.perf_counter(), _resident()
     discretization = method.build(problem, backend, plugins, ocp)
     return Shaped(discretization, key, nlp_solver, None, time.perf_counter() - began, resident)
+
+
+def layout(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
+           dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt", transcription_options: dict | None = None,
+           solver_options: dict | None = None, dynamics_options: dict | None = None) -> tuple[Discretization, float]:
+    """The Discretization of the shape without its constraints, kept for reuse (the LAYOUTS_KEPT most recently
+    used), and the seconds its graph took (0 when kept): its variables, grid and checks are the shape's whatever
+    the constraints, so it encodes and decodes a guess as the shape's own would, and a plan can find its guess,
+    and screen the collision rows by it, before it builds the rows (ocpkit.planner.simultaneous)."""
+    shaped = shape(problem, transcription, knots, dynamics, solver, (), transcription_options, solver_options,
+                   dynamics_options)
+    _LAYOUTS[shaped.key] = shaped.discretization
+    _LAYOUTS.move_to_end(shaped.key)
+    while len(_LAYOUTS) > LAYOUTS_KEPT:
+        _LAYOUTS.popitem(last=False)
+    return shaped.discretization, shaped.graph_time
 
 
 def prepare(shaped: Shaped, graph_time: float | None = None) -> Build:
@@ -174,6 +195,7 @@ def clear_builds() -> None:
     """Forget every cached build, and the parts kept for later builds (the dynamics rows' Functions, their
     derivatives and compiled code), and hand the memory back to the operating system."""
     _BUILDS.clear()
+    _LAYOUTS.clear()
     forget_defects()
     forget_made()
     _release()

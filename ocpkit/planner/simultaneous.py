@@ -21,7 +21,7 @@ from ocpkit.formats.trajectory import Trajectory
 from ocpkit.geometry.clearances import buried, sphere_centers_batch
 from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, PLANNERS, screening
-from ocpkit.planner.build_cache import Build, Shaped, prepare, shape
+from ocpkit.planner.build_cache import Build, Shaped, layout, prepare, shape
 from ocpkit.planner.guesses import STRAIGHT_LINE_RULES
 from ocpkit.planner.ladder import (DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, Rung,
                                    climb, ordered)
@@ -94,9 +94,11 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     solve, holding the start (a dense check of a placeholder motion would only spend the budget: seconds on a
     robot with thousands of sphere pairs); one that ends past the deadline (a long path search after a long
     build) ends the plan as `time_limit` with the guess's motion, without the rebuild or solve that could only
-    overrun. With screening (ocpkit.planner.screening) the first build keeps the collision rows near the straight
-    line. A guess that comes near rows left out is screened again, with them added, before the solver is prepared
-    (a solver's preparation is most of a build); an unverified solution that does is solved again on a rebuild,
+    overrun. With screening (ocpkit.planner.screening) the guess is found on the shape without its constraints
+    (ocpkit.planner.build_cache.layout, reused by the robot's later plans), and the build keeps the collision rows
+    near the straight line, and near the guess too where the guess comes near rows the line's screening leaves
+    out: the rows are built once, for the guess; an unverified solution that comes near rows left out is solved
+    again on a rebuild,
     unless its solve was stopped by time: at the deadline, or by its pace, which hands the rung's time on
     (ocpkit.planner.ladder), and a rebuild with more rows would only iterate more slowly.
     The builds before the first solve are the plan's set-up, a rebuild after it is computation."""
@@ -104,8 +106,11 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     near = _screening_start(problem, options)
     options = _checked_near_the_ends(problem, options)
     deadline = started + max_wall_time  # the set-up counts against the budget too
-    shaped = _shape(problem, options, near)
-    graph_time = shaped.graph_time
+    if near is None:
+        shaped = _shape(problem, options, None)
+        grid, graph_time = shaped.discretization, shaped.graph_time
+    else:  # the collision rows wait for the guess, encoded meanwhile on the shape without constraints
+        grid, graph_time = _layout(problem, options)
     dynamics = options.dynamics
     method = {"planner": "simultaneous", "transcription": options.transcription, "knots": options.knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options.solver}
@@ -114,18 +119,20 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     if "planning_time" in guess_options:  # a path search ends by the plan's deadline, after this rung's build
         guess_options["planning_time"] = min(guess_options["planning_time"], max(deadline - guessing, 0.0))
     try:
-        w = _guess(problem, shaped.discretization, guess, guess_options)
+        w = _guess(problem, grid, guess, guess_options)
     except NoGuess as exc:  # no motion to report: the robot holds its start, as in the baselines' no_path plans
         return finish(problem, hold(problem), "no_path", method, started, setup_time=graph_time,
                       message=f"guess {guess!r}: {exc}; not solved, the plan holds the start")
     guess_time = time.perf_counter() - guessing
     if time.perf_counter() >= deadline:  # the build and the guess took all the time: no rebuild, no solve
-        return finish(problem, shaped.discretization.decode(w), "time_limit", method, started,
+        return finish(problem, grid.decode(w), "time_limit", method, started,
                       setup_time=graph_time, message="the time ran out in the guess, before the first solve",
                       timing=Timing(guess=guess_time, setup={"graph": graph_time}))
-    if near is not None and (wider := _widened(problem, options, shaped.discretization, near,
-                                               shaped.discretization.decode(w))):
-        (shaped, near), graph_time = wider, graph_time + wider[0].graph_time  # w stays: screening drops rows only
+    if near is not None:  # w stays: the rows screened leave the variables as they are
+        lined = screening.screened(problem, options.constraints, near)
+        shaped, near = _widened(problem, options, lined, near, grid.decode(w)) or (_shape(problem, options, near),
+                                                                                    near)
+        graph_time += shaped.graph_time
     made = prepare(shaped, graph_time)
     first_setup = made.setup_time or graph_time  # a cached build: the graphs built on the way
     budget = options.iteration_budget
@@ -136,8 +143,8 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     while near is not None and not refined.verification.ok and rebuilds < screening.MAX_REBUILDS \
             and time.perf_counter() < deadline and refined.result.status != SolverStatus.TIME_LIMIT \
             and refined.iterations < budget \
-            and (wider := _widened(problem, options.capped(budget - refined.iterations), made.discretization, near,
-                                   refined.trajectory)):
+            and (wider := _widened(problem, options.capped(budget - refined.iterations),
+                                   made.discretization.constraints, near, refined.trajectory)):
         (shaped, near), rebuilds = wider, rebuilds + 1
         made = prepare(shaped)
         restart = made.discretization.relifted(refined.result.w, Refinement())  # the checks back at their defaults
@@ -188,6 +195,13 @@ def _checked_near_the_ends(problem: Problem, options: SimultaneousOptions) -> Si
     return dataclasses.replace(options, transcription_options={**options.transcription_options, "end_checks": True})
 
 
+def _layout(problem: Problem, options: SimultaneousOptions) -> tuple[Discretization, float]:
+    """The shape of `options` without its constraints (ocpkit.planner.build_cache.layout: kept for the robot's
+    later plans), and the seconds its graph took (0 when reused)."""
+    return layout(problem, options.transcription, options.knots, options.dynamics, options.solver,
+                  dict(options.transcription_options), dict(options.solver_options), options.dynamics_options)
+
+
 def _shape(problem: Problem, options: SimultaneousOptions, near: np.ndarray | None) -> Shaped:
     """The shape of `options` (its solver not prepared: ocpkit.planner.build_cache), its collision rows screened by
     `near`."""
@@ -201,21 +215,22 @@ def _lacking(problem: Problem, made: Build, near: np.ndarray | None) -> Callable
     rounds so the plan rebuilds with them instead; None without screening."""
     if near is None:
         return None
-    return lambda motion: _near_left_out(problem, made.discretization, motion) is not None
+    return lambda motion: _near_left_out(problem, made.discretization.constraints, motion) is not None
 
 
-def _near_left_out(problem: Problem, discretization: Discretization, motion: Trajectory) -> np.ndarray | None:
-    """Samples (K, n) of `motion` when it comes near rows `discretization` left out (ocpkit.planner.screening), else
-    None."""
+def _near_left_out(problem: Problem, constraints: Sequence[Constraint], motion: Trajectory) -> np.ndarray | None:
+    """Samples (K, n) of `motion` when it comes near rows the screened `constraints` left out
+    (ocpkit.planner.screening), else None."""
     samples = screening.motion_samples(motion)
-    return samples if screening.missing(problem, discretization.constraints, samples) else None
+    return samples if screening.missing(problem, constraints, samples) else None
 
 
-def _widened(problem: Problem, options: SimultaneousOptions, discretization: Discretization, near: np.ndarray,
+def _widened(problem: Problem, options: SimultaneousOptions, constraints: Sequence[Constraint], near: np.ndarray,
              motion: Trajectory) -> tuple[Shaped, np.ndarray] | None:
-    """The shape screened by `near` and samples of `motion` when `motion` comes near rows `discretization` left out,
-    with those configurations (K, n); None when it does not. Its solver is not prepared yet (`prepare`)."""
-    samples = _near_left_out(problem, discretization, motion)
+    """The shape screened by `near` and samples of `motion` when `motion` comes near rows the `constraints`
+    (screened by `near`) left out, with those configurations (K, n); None when it does not. Its solver is not
+    prepared yet (`prepare`)."""
+    samples = _near_left_out(problem, constraints, motion)
     if samples is None:
         return None
     near = np.vstack([near, samples])

@@ -11,7 +11,7 @@ from ocpkit.constraints import make_constraints
 from ocpkit.constraints.collision import SphereCollision
 from ocpkit.formats.scenario import load_scenario
 from ocpkit.geometry.clearances import clearances, sphere_centers_batch
-from ocpkit.planner.build_cache import clear_builds
+from ocpkit.planner.build_cache import clear_builds, layout, shape
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.screening import (CROWDED_DISTANCE, CROWDED_ROWS, SCREEN_DISTANCE, line_samples, missing,
                                      screenable_rows, screened, worth_screening)
@@ -102,27 +102,48 @@ def test_a_plan_checks_near_the_ends_when_an_end_is_close_to_contact_unless_told
     assert _checked_near_the_ends(PANDA, mesh) is mesh  # a mesh transcription has no such option
 
 
-def test_a_guess_near_left_out_rows_is_screened_again_before_the_solver_is_prepared(monkeypatch):
+def test_a_guess_near_left_out_rows_is_screened_with_them_before_the_rows_are_built(monkeypatch):
+    """The guess is encoded on the shape without constraints; the rows are built once, screened by the line and
+    the guess, and one solver prepared for them."""
     import ocpkit.planner.simultaneous as simultaneous
 
-    steps, real_shape, real_prepare, real_near = [], simultaneous.shape, simultaneous.prepare, \
-        simultaneous._near_left_out
-    monkeypatch.setattr(simultaneous, "shape", lambda *a, **k: steps.append("shape") or real_shape(*a, **k))
+    steps, screened_by = [], []
+    real_layout, real_shape, real_prepare, real_near = simultaneous.layout, simultaneous.shape, \
+        simultaneous.prepare, simultaneous._near_left_out
+    monkeypatch.setattr(simultaneous, "layout", lambda *a, **k: steps.append("layout") or real_layout(*a, **k))
+    monkeypatch.setattr(simultaneous, "shape", lambda *a, **k: steps.append("shape") or screened_by.append(
+        k["near"]) or real_shape(*a, **k))
     monkeypatch.setattr(simultaneous, "prepare", lambda *a, **k: steps.append("prepare") or real_prepare(*a, **k))
 
-    def near_for_the_guess(problem, discretization, motion):  # the guess comes near rows left out, as if
-        if steps == ["shape"]:
+    def near_for_the_guess(problem, constraints, motion):  # the guess comes near rows left out, as if
+        if steps == ["layout"]:
             return line_samples(problem) + 0.05
-        return real_near(problem, discretization, motion)
+        return real_near(problem, constraints, motion)
 
     monkeypatch.setattr(simultaneous, "_near_left_out", near_for_the_guess)
     clear_builds()
     plan = plan_simultaneous(PANDA, fallbacks=(), screen=True, knots=6, refinements=0,
                              solver_options={"max_iterations": 2})
-    assert steps[:3] == ["shape", "shape", "prepare"]  # one solver prepared, for the shape screened by the guess too
+    assert steps[:3] == ["layout", "shape", "prepare"]  # one shape and one solver, for the line and the guess
+    assert len(screened_by[0]) == 2 * len(line_samples(PANDA))
+    np.testing.assert_allclose(screened_by[0][len(line_samples(PANDA)):], line_samples(PANDA) + 0.05)
     setup = plan.stats.timing.setup
     assert setup["graph"] > 0 and setup["solver"] > 0
     assert plan.stats.setup_time == pytest.approx(setup["graph"] + setup["solver"] + setup["compile"])
+
+
+def test_the_guess_is_encoded_on_the_shape_without_constraints_as_on_the_screened_one():
+    """The layout's variables are the screened shape's, so a guess encodes and decodes alike on both."""
+    clear_builds()
+    grid, built = layout(PANDA, knots=6)
+    screened = shape(PANDA, knots=6, near=line_samples(PANDA)).discretization
+    assert not grid.constraints and screened.constraints
+    assert grid.nlp.variables.size == screened.nlp.variables.size
+    w = screened.initial_guess(PANDA)
+    np.testing.assert_array_equal(grid.initial_guess(PANDA), w)
+    times = np.linspace(0.0, screened.decode(w).tf, 7)
+    np.testing.assert_array_equal(grid.decode(w).interpolant(times).q, screened.decode(w).interpolant(times).q)
+    assert built > 0 and layout(PANDA, knots=6) == (grid, 0.0)  # kept for the robot's later plans
 
 
 @pytest.mark.parametrize("status, prepared", [(SolverStatus.ITERATION_LIMIT, 2), (SolverStatus.TIME_LIMIT, 1)])
@@ -133,7 +154,7 @@ def test_an_unverified_solve_near_left_out_rows_is_rebuilt_unless_it_was_stopped
 
     steps, real_prepare, real_solve = [], simultaneous.prepare, simultaneous.solve_refined
     monkeypatch.setattr(simultaneous, "prepare", lambda *a, **k: steps.append("prepare") or real_prepare(*a, **k))
-    monkeypatch.setattr(simultaneous, "_widened", lambda problem, options, discretization, near, motion:
+    monkeypatch.setattr(simultaneous, "_widened", lambda problem, options, constraints, near, motion:
                         None if steps.count("prepare") != 1 else  # once, after the first solve
                         (simultaneous._shape(problem, options, np.vstack([near, line_samples(problem) + 0.05])),
                          near))
