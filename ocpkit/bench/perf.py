@@ -90,9 +90,10 @@ def sample(result: Plan, linear_share: float = 0.0) -> Sample:
 
 def planned(problem: Problem, knots: int, fresh: bool = False, linear_share: float = 0.0, **options) -> Sample:
     """One single-shot plan of `problem` at `knots` (options as for `ocpkit.plan`); `fresh`: with an empty build
-    cache, so that it includes the set-up; `linear_share` as for `sample`."""
+    cache and none of the parts builds share, so that it includes the whole set-up; `linear_share` as for
+    `sample`."""
     if fresh:
-        clear_builds()
+        clear_builds(parts=True)
     return sample(plan(problem, knots=knots, fallbacks=SINGLE_SHOT, **options), linear_share)
 
 

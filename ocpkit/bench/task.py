@@ -5,7 +5,9 @@ process or a Dask worker on another machine can run it; each process keeps its o
 (ocpkit.planner.build_cache) while it plans one scenario, so its later methods and repeats of a shape it has built skip
 the set-up, and clears it when the scenario changes: builds held from earlier problems (large for a 7-joint MBM
 problem, and several per plan with the ladder's rungs and screening rebuilds) fill the memory and slow later
-plans (figures: docs/design-notes.md). The outcome is plain data too:
+plans (figures: docs/design-notes.md). The small parts a robot's builds share (ocpkit.planner.build_cache:
+layouts, the dynamics rows' derivatives and compiled code) stay, as in any process that plans many problems of
+one robot. The outcome is plain data too:
 the results row and the trajectory JSON text, written by the process that collects the outcomes.
 """
 

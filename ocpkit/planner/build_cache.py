@@ -191,13 +191,15 @@ def _staged_for(solver: str, solver_options: dict, transcription: str, transcrip
     raise OptionError(STAGES_NEEDED.format(solver=solver, what=unstaged))
 
 
-def clear_builds() -> None:
-    """Forget every cached build, and the parts kept for later builds (the dynamics rows' Functions, their
-    derivatives and compiled code), and hand the memory back to the operating system."""
+def clear_builds(parts: bool = False) -> None:
+    """Forget every cached build and hand the memory back to the operating system. The small parts kept for a
+    robot's later builds (`layout`s, the dynamics rows' Functions, their derivatives and compiled code) stay,
+    unless `parts`."""
     _BUILDS.clear()
-    _LAYOUTS.clear()
-    forget_defects()
-    forget_made()
+    if parts:
+        _LAYOUTS.clear()
+        forget_defects()
+        forget_made()
     _release()
 
 

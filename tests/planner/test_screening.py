@@ -134,7 +134,7 @@ def test_a_guess_near_left_out_rows_is_screened_with_them_before_the_rows_are_bu
 
 def test_the_guess_is_encoded_on_the_shape_without_constraints_as_on_the_screened_one():
     """The layout's variables are the screened shape's, so a guess encodes and decodes alike on both."""
-    clear_builds()
+    clear_builds(parts=True)
     grid, built = layout(PANDA, knots=6)
     screened = shape(PANDA, knots=6, near=line_samples(PANDA)).discretization
     assert not grid.constraints and screened.constraints
@@ -144,6 +144,10 @@ def test_the_guess_is_encoded_on_the_shape_without_constraints_as_on_the_screene
     times = np.linspace(0.0, screened.decode(w).tf, 7)
     np.testing.assert_array_equal(grid.decode(w).interpolant(times).q, screened.decode(w).interpolant(times).q)
     assert built > 0 and layout(PANDA, knots=6) == (grid, 0.0)  # kept for the robot's later plans
+    clear_builds()
+    assert layout(PANDA, knots=6) == (grid, 0.0)  # the builds go, the parts a robot's builds share stay
+    clear_builds(parts=True)
+    assert layout(PANDA, knots=6)[0] is not grid
 
 
 @pytest.mark.parametrize("status, prepared", [(SolverStatus.ITERATION_LIMIT, 2), (SolverStatus.TIME_LIMIT, 1)])
