@@ -3,11 +3,12 @@
 A task is plain data (a dict: the scenario mapping, case, scene, method, repeat, suite), so a local worker
 process or a Dask worker on another machine can run it; each process keeps its own build cache
 (ocpkit.planner.build_cache) while it plans one scenario, so its later methods and repeats of a shape it has built skip
-the set-up, and clears it when the scenario changes: builds held from earlier problems (large for a 7-joint MBM
-problem, and several per plan with the ladder's rungs and screening rebuilds) fill the memory and slow later
-plans (figures: docs/design-notes.md). The small parts a robot's builds share (ocpkit.planner.build_cache:
-layouts, the dynamics rows' derivatives and compiled code) stay, as in any process that plans many problems of
-one robot. The outcome is plain data too:
+the set-up, and drops the builds screened for that scenario's motions when the scenario changes: no other problem
+has their rows, and builds held from earlier problems (several per plan with the ladder's rungs and screening
+rebuilds) fill the memory and slow later plans (figures: docs/design-notes.md). What later problems can share
+stays, within the cache's memory budget, as in any process that plans many problems of one robot: unscreened
+builds (the safety nets' timing NLPs) and the small parts every build of a robot shares (layouts, the dynamics
+rows' derivatives and compiled code). The outcome is plain data too:
 the results row and the trajectory JSON text, written by the process that collects the outcomes.
 """
 
@@ -24,7 +25,7 @@ from ocpkit.formats.record import RESULT_COLUMNS, result_row, trajectory_header
 from ocpkit.formats.scenario import problem_from_dict
 from ocpkit.formats.trajectory import write_json
 from ocpkit.planner import plan
-from ocpkit.planner.build_cache import clear_builds
+from ocpkit.planner.build_cache import drop_screened
 from ocpkit.planner.ladder import DEFAULT_LADDER
 from ocpkit.problem import Problem
 from ocpkit.result import Plan, finish
@@ -89,11 +90,11 @@ _planning: tuple[str, str] | None = None  # the (suite, case) this process plann
 
 def run_task(task: dict) -> dict:
     """Plan the task; return {"row": the results row (RUN_COLUMNS), "trajectory": the trajectory JSON text}.
-    The process's builds are cleared first if its last task was another scenario (module docstring)."""
+    The process's screened builds are dropped first if its last task was another scenario (module docstring)."""
     global _planning
     scenario = (task["suite"], task["case"])
     if _planning != scenario:
-        clear_builds()
+        drop_screened()
         _planning = scenario
     started = time.perf_counter()
     problem = problem_from_dict(task["scenario"], name=task["case"])

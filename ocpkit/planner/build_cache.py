@@ -59,6 +59,7 @@ class Build:
     setup_time: float
     setup_parts: dict = field(default_factory=dict)
     nbytes: int = 0  # estimated memory held, bytes (0 when it came from the cache)
+    screened: bool = False  # its collision rows screened for one problem's motion (`drop_screened`)
 
 
 _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
@@ -79,6 +80,7 @@ class Shaped:
     cached: Build | None
     graph_time: float
     resident: int  # bytes of resident memory before the graph was built
+    screened: bool = False  # its collision rows screened for one problem's motion
 
 
 def build(problem: Problem, transcription: str = "chebyshev", knots: int = 12, dynamics: str | Dynamics = "casadi-rnea",
@@ -113,7 +115,7 @@ def shape(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
         return Shaped(_LAYOUTS[key], key, nlp_solver, None, 0.0, _resident())
     began, resident = time.perf_counter(), _resident()
     discretization = method.build(problem, backend, plugins, ocp)
-    return Shaped(discretization, key, nlp_solver, None, time.perf_counter() - began, resident)
+    return Shaped(discretization, key, nlp_solver, None, time.perf_counter() - began, resident, near is not None)
 
 
 def layout(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
@@ -144,7 +146,7 @@ def prepare(shaped: Shaped, graph_time: float | None = None) -> Build:
     ended, compiled = time.perf_counter(), compile_seconds() - compiling
     _BUILDS[shaped.key] = Build(shaped.discretization, prepared, graph + ended - began,
                                 {"graph": graph, "solver": ended - began - compiled, "compile": compiled},
-                                max(_resident() - shaped.resident, SMALLEST_BUILD))
+                                max(_resident() - shaped.resident, SMALLEST_BUILD), shaped.screened)
     _evict(memory_budget())
     return _BUILDS[shaped.key]
 
@@ -189,6 +191,15 @@ def _staged_for(solver: str, solver_options: dict, transcription: str, transcrip
         return {**transcription_options, "staged": True}
     unstaged = f"{transcription} with staged=False" if "staged" in transcription_options else transcription
     raise OptionError(STAGES_NEEDED.format(solver=solver, what=unstaged))
+
+
+def drop_screened() -> None:
+    """Forget the builds whose collision rows were screened for one problem's motion (no other problem has their
+    key) and hand the memory back to the operating system; the others (a safety net's timing NLP, a problem's
+    without screening) stay for the next problem of their shape, within the memory budget."""
+    for key in [key for key, made in _BUILDS.items() if made.screened]:
+        del _BUILDS[key]
+    _release()
 
 
 def clear_builds(parts: bool = False) -> None:

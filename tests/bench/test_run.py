@@ -283,7 +283,7 @@ def test_a_planner_that_raises_gives_a_failed_row_naming_the_exception_not_a_cra
     assert json.loads(outcome["trajectory"])["status"] == "failed"
 
 
-def test_a_worker_keeps_its_builds_within_a_scenario_and_clears_them_when_the_scenario_changes(monkeypatch):
+def test_a_worker_keeps_its_builds_within_a_scenario_and_drops_the_screened_ones_when_it_changes(monkeypatch):
     import ocpkit.bench.task as task_module
     from ocpkit.bench.task import make_task, run_task
 
@@ -292,7 +292,7 @@ def test_a_worker_keeps_its_builds_within_a_scenario_and_clears_them_when_the_sc
 
     cleared = []
     monkeypatch.setattr(task_module, "plan", broken)
-    monkeypatch.setattr(task_module, "clear_builds", lambda: cleared.append(True))
+    monkeypatch.setattr(task_module, "drop_screened", lambda: cleared.append(True))
     monkeypatch.setattr(task_module, "_planning", None)
     suite = load_suite(REPO / "suites/paper.yaml")
     first, second = suite.scenarios[:2]

@@ -134,10 +134,19 @@ def test_a_process_past_its_budget_keeps_only_the_newest_build_and_returns_the_m
     assert ocpkit.build(PROBLEM, knots=7).discretization is not b
 
 
-def test_clear_builds_forgets_everything():
+def test_clear_builds_forgets_every_build():
     first = ocpkit.build(PROBLEM, knots=6)
     clear_builds()
     assert ocpkit.build(PROBLEM, knots=6).discretization is not first.discretization
+
+
+def test_drop_screened_forgets_the_builds_screened_for_a_motion_and_keeps_the_others():
+    near = np.vstack([PROBLEM.start, PROBLEM.goal])
+    screened, shared = ocpkit.build(PROBLEM, knots=6, near=near), ocpkit.build(PROBLEM, knots=6)
+    assert screened.screened and not shared.screened
+    build_cache.drop_screened()
+    assert ocpkit.build(PROBLEM, knots=6).setup_time == 0.0  # the unscreened build stays for other problems
+    assert ocpkit.build(PROBLEM, knots=6, near=near).discretization is not screened.discretization
 
 
 def test_a_solver_option_with_a_dict_value_is_accepted_and_cached():
