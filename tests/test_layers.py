@@ -9,8 +9,8 @@ import pytest
 from helpers import REPO
 
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("values", ("ocpkit.errors", "ocpkit.registry", "ocpkit.interrupt", "ocpkit.nlp", "ocpkit.tolerances",
-                "ocpkit.formats", "ocpkit.formats.schema", "ocpkit.formats.trajectory")),
+    ("values", ("ocpkit.errors", "ocpkit.registry", "ocpkit.interrupt", "ocpkit.kept", "ocpkit.nlp",
+                "ocpkit.tolerances", "ocpkit.formats", "ocpkit.formats.schema", "ocpkit.formats.trajectory")),
     ("robots and geometry", ("ocpkit.robots", "ocpkit.geometry")),
     ("problem", ("ocpkit.problem", "ocpkit.validation", "ocpkit.formats.scenario", "ocpkit.formats.moveit",
                  "ocpkit.formats.mbm")),

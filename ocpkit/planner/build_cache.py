@@ -30,6 +30,7 @@ import psutil
 from ocpkit.constraints import DEFAULT_CONSTRAINTS, Constraint, make_constraints
 from ocpkit.dynamics import Dynamics, make_dynamics
 from ocpkit.errors import OptionError
+from ocpkit.kept import Kept
 from ocpkit.planner.screening import screened
 from ocpkit.problem import Problem
 from ocpkit.registry import construct
@@ -63,9 +64,8 @@ class Build:
 
 
 _BUILDS: OrderedDict[tuple, Build] = OrderedDict()
-LAYOUTS_KEPT = 8
+_LAYOUTS: Kept[Discretization] = Kept(8)
 """Discretizations without constraints kept for reuse (`layout`)."""
-_LAYOUTS: OrderedDict[tuple, Discretization] = OrderedDict()
 
 
 @dataclass(frozen=True)
@@ -121,16 +121,13 @@ def shape(problem: Problem, transcription: str = "chebyshev", knots: int = 12, d
 def layout(problem: Problem, transcription: str = "chebyshev", knots: int = 12,
            dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt", transcription_options: dict | None = None,
            solver_options: dict | None = None, dynamics_options: dict | None = None) -> tuple[Discretization, float]:
-    """The Discretization of the shape without its constraints, kept for reuse (the LAYOUTS_KEPT most recently
-    used), and the seconds its graph took (0 when kept): its variables, grid and checks are the shape's whatever
+    """The Discretization of the shape without its constraints, kept for reuse (the most recently used, `_LAYOUTS`),
+    and the seconds its graph took (0 when kept): its variables, grid and checks are the shape's whatever
     the constraints, so it encodes and decodes a guess as the shape's own would, and a plan can find its guess,
     and screen the collision rows by it, before it builds the rows (ocpkit.planner.simultaneous)."""
     shaped = shape(problem, transcription, knots, dynamics, solver, (), transcription_options, solver_options,
                    dynamics_options)
-    _LAYOUTS[shaped.key] = shaped.discretization
-    _LAYOUTS.move_to_end(shaped.key)
-    while len(_LAYOUTS) > LAYOUTS_KEPT:
-        _LAYOUTS.popitem(last=False)
+    _LAYOUTS.put(shaped.key, shaped.discretization)
     return shaped.discretization, shaped.graph_time
 
 

@@ -32,7 +32,6 @@ path-timing OCP's jerk in its objective) take the SX graph.
 from __future__ import annotations
 
 import functools
-from collections import OrderedDict
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -40,13 +39,13 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
+from ocpkit.kept import Kept
 from ocpkit.nlp import NLP, PointCall
 from ocpkit.solvers.compiled import cache_directory, compiled, compiler
 
 T = TypeVar("T")
-MADE_KEPT = 16
-"""Point derivatives and compiled code kept for reuse (`_made_once`)."""
-_MADE: OrderedDict[tuple, tuple[tuple[ca.Function, ...], Any]] = OrderedDict()
+_MADE: Kept[tuple[tuple[ca.Function, ...], Any]] = Kept(16)
+"""Point derivatives and compiled code kept for reuse (`_made_once`), with the Functions they were made for."""
 
 ROWS_AT_ONCE = 6
 """The other rows are differentiated this many consecutive rows at a time: rows added together read the same few
@@ -204,17 +203,11 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
 
 
 def _made_once(functions: tuple[ca.Function, ...], key: tuple, make: Callable[[], T]) -> T:
-    """make()'s value, made once for these Function objects and `key` while they are among the MADE_KEPT most
-    recently used: the dynamics rows' point Function is one object for every NLP of a robot and OCP
-    (ocpkit.transcription.assembly), so its derivatives and their compiled code are built once. The entry holds
-    the Functions, so no other object takes their ids while it lasts."""
-    entry = (*map(id, functions), *key)
-    if entry not in _MADE:
-        _MADE[entry] = functions, make()
-        while len(_MADE) > MADE_KEPT:
-            _MADE.popitem(last=False)
-    _MADE.move_to_end(entry)
-    return _MADE[entry][1]
+    """make()'s value, made once for these Function objects and `key` while it is kept (`_MADE`): the dynamics
+    rows' point Function is one object for every NLP of a robot and OCP (ocpkit.transcription.assembly), so its
+    derivatives and their compiled code are built once. The entry holds the Functions, so no other object takes
+    their ids while it lasts."""
+    return _MADE.get((*map(id, functions), *key), lambda: (functions, make()))[1]
 
 
 def forget_made() -> None:

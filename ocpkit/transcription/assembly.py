@@ -26,7 +26,6 @@ against the OCP it discretizes (ocpkit.transcription.ocp: the paper's robot OCP 
 from __future__ import annotations
 
 import dataclasses
-from collections import OrderedDict
 from collections.abc import Callable, Sequence
 
 import casadi as ca
@@ -34,15 +33,15 @@ import numpy as np
 
 from ocpkit.constraints import Constraint, Context, PointValues, Rows
 from ocpkit.dynamics import Dynamics
+from ocpkit.kept import Kept
 from ocpkit.nlp import NLP, Layout, PointCall, Stages
 from ocpkit.problem import Problem
 from ocpkit.transcription.ocp import OCP, Node, RobotOCP
 
 __all__ = ["Assembly", "Node", "forget_defects"]
 
-DEFECTS_KEPT = 16
-"""The OCP's defect Functions kept for reuse (`_defect_function`): one per dynamics backend and OCP in use."""
-_DEFECTS: OrderedDict[tuple, ca.Function] = OrderedDict()
+_DEFECTS: Kept[ca.Function] = Kept(16)
+"""The OCP's defect Functions kept for reuse (`Assembly._defect_function`): one per dynamics backend and OCP."""
 
 
 class Assembly:
@@ -118,14 +117,10 @@ class Assembly:
         code, are reused with it (ocpkit.solvers.pointwise), and its graph is made once."""
         key = (self.dynamics and self.dynamics.key, type(self.ocp), self.ocp.key, tuple(p.shape for p in parts),
                tuple(p.shape for p in self._ocp_parameters))
-        if key not in _DEFECTS:
-            symbols = _symbols_like(parts)
-            _DEFECTS[key] = ca.Function("defect", [*symbols, *self._ocp_parameters],
-                                        [self.ocp.defect(self.dynamics, self.ocp.split(ca.vertcat(*symbols)))])
-            while len(_DEFECTS) > DEFECTS_KEPT:
-                _DEFECTS.popitem(last=False)
-        _DEFECTS.move_to_end(key)
-        return _DEFECTS[key]
+        symbols = _symbols_like(parts)
+        return _DEFECTS.get(key, lambda: ca.Function(
+            "defect", [*symbols, *self._ocp_parameters],
+            [self.ocp.defect(self.dynamics, self.ocp.split(ca.vertcat(*symbols)))]))
 
     def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX) -> ca.SX:
         """The OCP's running-cost inputs at a point at time t where the controls have slope du/dσ = `du_ds`."""
