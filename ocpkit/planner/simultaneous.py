@@ -98,9 +98,8 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     (ocpkit.planner.build_cache.layout, reused by the robot's later plans), and the build keeps the collision rows
     near the straight line, and near the guess too where the guess comes near rows the line's screening leaves
     out: the rows are built once, for the guess; an unverified solution that comes near rows left out is solved
-    again on a rebuild,
-    unless its solve was stopped by time: at the deadline, or by its pace, which hands the rung's time on
-    (ocpkit.planner.ladder), and a rebuild with more rows would only iterate more slowly.
+    again on a rebuild, unless its solve was stopped by time: at the deadline, or by its pace, which hands the
+    rung's time on (ocpkit.planner.ladder), and a rebuild with more rows would only iterate more slowly.
     The builds before the first solve are the plan's set-up, a rebuild after it is computation."""
     started = time.perf_counter()
     near = _screening_start(problem, options)
@@ -108,9 +107,9 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     deadline = started + max_wall_time  # the set-up counts against the budget too
     if near is None:
         shaped = _shape(problem, options, None)
-        grid, graph_time = shaped.discretization, shaped.graph_time
+        encoding, graph_time = shaped.discretization, shaped.graph_time
     else:  # the collision rows wait for the guess, encoded meanwhile on the shape without constraints
-        grid, graph_time = _layout(problem, options)
+        encoding, graph_time = _layout(problem, options)
     dynamics = options.dynamics
     method = {"planner": "simultaneous", "transcription": options.transcription, "knots": options.knots,
               "dynamics": dynamics if isinstance(dynamics, str) else dynamics.name, "solver": options.solver}
@@ -119,19 +118,19 @@ def _single_shot(problem: Problem, options: SimultaneousOptions, max_wall_time: 
     if "planning_time" in guess_options:  # a path search ends by the plan's deadline, after this rung's build
         guess_options["planning_time"] = min(guess_options["planning_time"], max(deadline - guessing, 0.0))
     try:
-        w = _guess(problem, grid, guess, guess_options)
+        w = _guess(problem, encoding, guess, guess_options)
     except NoGuess as exc:  # no motion to report: the robot holds its start, as in the baselines' no_path plans
         return finish(problem, hold(problem), "no_path", method, started, setup_time=graph_time,
                       message=f"guess {guess!r}: {exc}; not solved, the plan holds the start")
     guess_time = time.perf_counter() - guessing
     if time.perf_counter() >= deadline:  # the build and the guess took all the time: no rebuild, no solve
-        return finish(problem, grid.decode(w), "time_limit", method, started,
+        return finish(problem, encoding.decode(w), "time_limit", method, started,
                       setup_time=graph_time, message="the time ran out in the guess, before the first solve",
                       timing=Timing(guess=guess_time, setup={"graph": graph_time}))
     if near is not None:  # w stays: the rows screened leave the variables as they are
         lined = screening.screened(problem, options.constraints, near)
-        shaped, near = _widened(problem, options, lined, near, grid.decode(w)) or (_shape(problem, options, near),
-                                                                                    near)
+        wider = _widened(problem, options, lined, near, encoding.decode(w))
+        shaped, near = wider or (_shape(problem, options, near), near)
         graph_time += shaped.graph_time
     made = prepare(shaped, graph_time)
     first_setup = made.setup_time or graph_time  # a cached build: the graphs built on the way

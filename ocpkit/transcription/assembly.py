@@ -40,8 +40,9 @@ from ocpkit.transcription.ocp import OCP, Node, RobotOCP
 
 __all__ = ["Assembly", "Node", "forget_defects"]
 
-_DEFECTS: Kept[ca.Function] = Kept(16)
-"""The OCP's defect Functions kept for reuse (`Assembly._defect_function`): one per dynamics backend and OCP."""
+_DEFECTS: Kept[tuple[OCP, ca.Function]] = Kept(16)
+"""The OCP's defect Functions kept for reuse (`Assembly._defect_function`), one per dynamics backend and OCP, with
+the OCP they were made for."""
 
 
 class Assembly:
@@ -117,10 +118,13 @@ class Assembly:
         code, are reused with it (ocpkit.solvers.pointwise), and its graph is made once."""
         key = (self.dynamics and self.dynamics.key, type(self.ocp), self.ocp.key, tuple(p.shape for p in parts),
                tuple(p.shape for p in self._ocp_parameters))
-        symbols = _symbols_like(parts)
-        return _DEFECTS.get(key, lambda: ca.Function(
-            "defect", [*symbols, *self._ocp_parameters],
-            [self.ocp.defect(self.dynamics, self.ocp.split(ca.vertcat(*symbols)))]))
+
+        def made() -> tuple[OCP, ca.Function]:  # with the OCP, whose key may hold its model's id: kept alive
+            symbols = _symbols_like(parts)
+            return self.ocp, ca.Function("defect", [*symbols, *self._ocp_parameters],
+                                         [self.ocp.defect(self.dynamics, self.ocp.split(ca.vertcat(*symbols)))])
+
+        return _DEFECTS.get(key, made)[1]
 
     def running(self, x: Node, du_ds: ca.SX, dt_ds: ca.SX, t: ca.SX) -> ca.SX:
         """The OCP's running-cost inputs at a point at time t where the controls have slope du/dσ = `du_ds`."""
