@@ -39,10 +39,11 @@ AXES = {"X": 0, "Y": 1, "Z": 2}
 
 
 @dataclass(frozen=True)
-class _Joint:
-    """One 1-DoF joint of a robot's model as `sphere_centers_batch` composes it: its parent joint, its q index,
-    its placement in the parent (rotation (3, 3), translation (3,)); revolute: the cross-product matrix [a]x of
-    its axis and [a]x² (Rodrigues), prismatic: the axis in the parent's frame."""
+class ChainJoint:
+    """One 1-DoF joint of a robot's model as `sphere_centers_batch` (and the path search's compiled test,
+    ocpkit.planner.sphere_check) composes it: its parent joint, its q index, its placement in the parent (rotation
+    (3, 3), translation (3,)); revolute: the cross-product matrix [a]x of its axis and [a]x² (Rodrigues),
+    prismatic: the axis in the parent's frame."""
 
     parent: int
     index: int
@@ -55,7 +56,7 @@ class _Joint:
 
 
 @functools.lru_cache(maxsize=32)
-def _joints(robot: Robot) -> tuple[_Joint, ...]:
+def joint_chain(robot: Robot) -> tuple[ChainJoint, ...]:
     """The joints 1, 2, ... of `robot`'s model (robots hash by identity)."""
     out = []
     for j in range(1, robot.model.njoints):
@@ -63,7 +64,7 @@ def _joints(robot: Robot) -> tuple[_Joint, ...]:
         kind = joint.shortname()
         axis = joint.extract().axis if kind.endswith("Unaligned") else np.eye(3)[AXES[kind[-1]]]
         cross = np.cross(np.eye(3), axis)
-        out.append(_Joint(robot.model.parents[j], joint.idx_q, placement.rotation.copy(),
+        out.append(ChainJoint(robot.model.parents[j], joint.idx_q, placement.rotation.copy(),
                           placement.translation.copy(), kind.startswith("JointModelR"), cross, cross @ cross,
                           placement.rotation @ axis))
     return tuple(out)
@@ -83,7 +84,7 @@ def points_on_joints(robot: Robot, qs: np.ndarray, joints: np.ndarray, offsets: 
     rotation = np.empty((robot.model.njoints, len(qs), 3, 3))
     translation = np.empty((robot.model.njoints, len(qs), 3))
     rotation[0], translation[0] = np.eye(3), 0.0
-    for j, joint in enumerate(_joints(robot), start=1):
+    for j, joint in enumerate(joint_chain(robot), start=1):
         q = qs[:, joint.index]
         if joint.revolute:  # Rodrigues: R(q) = I + sin q [a]x + (1 − cos q) [a]x²
             turn = np.sin(q)[:, None, None] * joint.cross + (1 - np.cos(q))[:, None, None] * joint.cross_squared

@@ -5,8 +5,9 @@ simultaneous planner's "ompl" guess (ocpkit.planner.guesses) starts from it, and
 step is one function below, `ompl_seed` runs them in turn:
 
 1. `FreeSpace`: OMPL's validity test is the verifier's own collision model (`geometry.clearances`: robot
-   spheres against each other, the obstacles and the workspace box), asked in C++ (`geometry.coal_check`):
-   a configuration is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
+   spheres against each other, the obstacles and the workspace box), asked in compiled C
+   (`planner.sphere_check`; coal's test in C++, `geometry.coal_check`, where nothing compiles): a configuration
+   is valid iff every clearance is ≥ `margin` (m, 0.01 like the transcriptions' default).
    The joint limits are the state-space bounds.
 2. `ompl_path`: RRTConnect (or RRT*, BIT*, PRM, LBKPIECE1, or RRTConnect then LBKPIECE1) in joint space, its slow
    joints' coordinates scaled by their velocity limits (`JointSpace`, `time_scale`): OMPL's distances, and so its
@@ -69,8 +70,8 @@ import pinocchio as pin
 from ocpkit.errors import OptionError, RegistryError
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.geometry.clearances import clearances, sphere_centers
-from ocpkit.geometry.coal_check import CoalCheck
 from ocpkit.problem import Problem
+from ocpkit.planner.sphere_check import collision_check
 from ocpkit.result import PathStats, Timing
 from ocpkit.robots import Robot, rigid_torque
 
@@ -93,14 +94,14 @@ SEED_STRIDE = 1000  # a repeated search's seed is seed + k SEED_STRIDE: clear of
 class FreeSpace:
     """The verifier's collision model as a yes/no test: free iff every clearance is ≥ `margin` (m).
 
-    `free`, `segment_free` and `keeps` ask coal (ocpkit.geometry.coal_check, the same answers in C++), `clearance`
-    the NumPy reference. Counts the configurations it has tested (`checks`)."""
+    `free`, `segment_free` and `keeps` ask the compiled test (ocpkit.planner.sphere_check: the same answers in C),
+    `clearance` the NumPy reference. Counts the configurations it has tested (`checks`)."""
 
     def __init__(self, problem: Problem, margin: float) -> None:
         self.robot, self.scene, self.margin = problem.robot, problem.scene, margin
         self.data = problem.robot.model.createData()
-        self.coal = CoalCheck(problem.robot, problem.scene, margin)
-        self._by_margin = {margin: self.coal}  # a CoalCheck per margin asked (`keeps`), made on first use
+        self.test = collision_check(problem.robot, problem.scene, margin)
+        self._by_margin = {margin: self.test}  # a test per margin asked (`keeps`), made on first use
         self.checks = 0
 
     def clearance(self, q: np.ndarray) -> np.ndarray:
@@ -117,7 +118,7 @@ class FreeSpace:
     def keeps(self, q: np.ndarray, margin: float) -> np.ndarray:
         """Whether each configuration of q (K, n) keeps `margin` (m), the space's own or another: shape (K,), bool."""
         if margin not in self._by_margin:
-            self._by_margin[margin] = CoalCheck(self.robot, self.scene, margin)
+            self._by_margin[margin] = collision_check(self.robot, self.scene, margin)
         self.checks += len(q)
         return self._by_margin[margin].free(q)
 
@@ -129,7 +130,7 @@ class FreeSpace:
         in batches of SEGMENT_BATCH, then twice as many, and so on, up to the batch holding the collision: the
         unit every check budget (and so the random suite's certificate of room to pass) has been counted in."""
         count = max(int(np.ceil(np.linalg.norm(b - a) / resolution)), 1)
-        hit = self.coal.first_collision(a + np.outer(_coarse_to_fine(count) / count, b - a))
+        hit = self.test.first_collision(a + np.outer(_coarse_to_fine(count) / count, b - a))
         if hit is None:
             self.checks += count
         else:

@@ -1,4 +1,4 @@
-"""CasADi Functions compiled to C, once per machine.
+"""CasADi Functions, and other C, compiled once per machine.
 
 `compiled(functions)` generates their C (casadi.CodeGenerator), compiles it with the system C compiler ($CC, else
 `cc`) into a shared library kept in a disk cache named by the hash of the C, the compiler and its flags
@@ -7,6 +7,7 @@ with casadi.external: the same values as CasADi's virtual machine, evaluated fas
 A library is written under a temporary name and renamed into place, so processes compiling the same C at once do
 not clash.
 Without a compiler, or when a compile or the loading fails, there is nothing to load: None, with one warning.
+`shared_library(source)` is the same cache for C written by hand (ocpkit.planner.sphere_check).
 """
 
 from __future__ import annotations
@@ -53,18 +54,9 @@ def compiled(functions: Sequence[ca.Function]) -> list[ca.Function] | None:
     generator = ca.CodeGenerator("ocpkit_compiled.c", {"with_header": False})
     for function in functions:
         generator.add(function)
-    source = generator.dump()
-    cc = compiler()
-    if cc is None:
-        return _unavailable("no C compiler found (install gcc, or set CC)")
-    digest = hashlib.sha256("\0".join([source, Path(cc).name, *FLAGS]).encode()).hexdigest()[:24]
-    library = cache_directory() / f"{digest}.so"
-    if not library.exists():
-        try:
-            _compile(cc, source, library)
-        except (OSError, subprocess.CalledProcessError) as exc:
-            detail = exc.stderr.decode(errors="replace").strip()[-300:] if getattr(exc, "stderr", None) else exc
-            return _unavailable(f"compiling to {library} failed: {detail}")
+    library = shared_library(generator.dump())
+    if library is None:
+        return None
     try:
         return [ca.external(function.name(), str(library)) for function in functions]
     except RuntimeError as exc:  # e.g. a library damaged on disk
@@ -72,7 +64,24 @@ def compiled(functions: Sequence[ca.Function]) -> list[ca.Function] | None:
                             f"{str(exc).strip().splitlines()[-1]}")
 
 
-def _compile(cc: str, source: str, library: Path) -> None:
+def shared_library(source: str, flags: Sequence[str] = FLAGS) -> Path | None:
+    """The shared library of the C `source` compiled with `flags`, from the disk cache, compiling on a miss; None
+    (with one warning) without a compiler or when the compile fails."""
+    cc = compiler()
+    if cc is None:
+        return _unavailable("no C compiler found (install gcc, or set CC)")
+    digest = hashlib.sha256("\0".join([source, Path(cc).name, *flags]).encode()).hexdigest()[:24]
+    library = cache_directory() / f"{digest}.so"
+    if not library.exists():
+        try:
+            _compile(cc, source, library, flags)
+        except (OSError, subprocess.CalledProcessError) as exc:
+            detail = exc.stderr.decode(errors="replace").strip()[-300:] if getattr(exc, "stderr", None) else exc
+            return _unavailable(f"compiling to {library} failed: {detail}")
+    return library
+
+
+def _compile(cc: str, source: str, library: Path, flags: Sequence[str]) -> None:
     """Compile `source` into `library`, written under a temporary name and renamed into place."""
     global _spent
     began = time.perf_counter()
@@ -80,13 +89,14 @@ def _compile(cc: str, source: str, library: Path) -> None:
     with tempfile.TemporaryDirectory(dir=library.parent) as work:
         c_file, built = Path(work) / "functions.c", Path(work) / "functions.so"
         c_file.write_text(source)
-        subprocess.run([cc, *FLAGS, str(c_file), "-o", str(built)], check=True, capture_output=True)
+        subprocess.run([cc, *flags, str(c_file), "-o", str(built)], check=True, capture_output=True)
         os.replace(built, library)
     _spent += time.perf_counter() - began
 
 
 def _unavailable(reason: str) -> None:
-    """None, with a warning (once per reason) that CasADi's virtual machine evaluates instead."""
+    """None, with a warning (once per reason) that slower code computes the same values instead."""
     if reason not in _warned:
         _warned.add(reason)
-        warnings.warn(f"{reason}; CasADi's virtual machine evaluates instead (same values, slower)", stacklevel=3)
+        warnings.warn(f"{reason}; slower code computes the same values instead (CasADi's virtual machine; coal for "
+                      "the path search's collision test)", stacklevel=3)

@@ -1,0 +1,154 @@
+"""The path search's collision test, compiled: the sphere model's yes/no answer in a few microseconds.
+
+`SphereCheck(robot, scene, margin)` answers what `clearances(...) >= margin` answers (ocpkit.geometry.clearances,
+the verifier's model) for many configurations in one call, in C (sphere_check.c, compiled once per machine by
+ocpkit.solvers.compiled): the joints' poses by Rodrigues' formula from the model's placements (the joints
+`sphere_centers_batch` composes), the sphere centres, then every sphere against every obstacle and workspace face
+and every self-collision pair, stopping at the first clearance below the margin. The signed distances are
+ocpkit.geometry.distance's. What makes it fast is what it does not test: the spheres on one joint (a link) have a
+bounding sphere, and a link whose bound keeps clear of an obstacle, or of another link, skips all its spheres'
+tests against it; so does a sphere whose own distance to an obstacle's centre exceeds the obstacle's reach.
+Both skips are exact (a skipped pair's clearance is above the margin). `collision_check` returns it, or coal's
+test (ocpkit.geometry.coal_check, the same answers, ~4× slower) when there is no C compiler.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import functools
+from importlib import resources
+
+import numpy as np
+
+from ocpkit.geometry.clearances import joint_chain
+from ocpkit.geometry.coal_check import CoalCheck
+from ocpkit.geometry.scene import Scene
+from ocpkit.robots import Robot
+from ocpkit.solvers.compiled import shared_library
+
+FLAGS = ("-O2", "-fPIC", "-shared")
+_INT, _REAL = ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_double)
+
+
+class _Model(ctypes.Structure):
+    """sphere_check.c's Model, field for field."""
+
+    _fields_ = [("dof", ctypes.c_int), ("joints", ctypes.c_int), ("parent", _INT), ("index", _INT),
+                ("revolute", _INT), ("rotation", _REAL), ("cross", _REAL), ("cross_squared", _REAL),
+                ("translation", _REAL), ("slide", _REAL), ("spheres", ctypes.c_int), ("sphere_joint", _INT),
+                ("offset", _REAL), ("radius", _REAL), ("links", ctypes.c_int), ("link_joint", _INT),
+                ("link_first", _INT), ("link_end", _INT), ("link_center", _REAL), ("link_reach", _REAL),
+                ("link_pairs", ctypes.c_int), ("pair_link_a", _INT), ("pair_link_b", _INT), ("pair_first", _INT),
+                ("pair_end", _INT), ("pair_a", _INT), ("pair_b", _INT), ("obstacles", ctypes.c_int),
+                ("kind", _INT), ("center", _REAL), ("axes", _REAL), ("half", _REAL), ("bound", _REAL),
+                ("workspace", ctypes.c_int), ("lower", _REAL), ("upper", _REAL), ("margin", ctypes.c_double)]
+
+
+@functools.cache
+def _kernel() -> ctypes.CDLL | None:
+    """sphere_check.c's library, loaded once per process; None without a compiler."""
+    source = resources.files("ocpkit.planner").joinpath("sphere_check.c").read_text()
+    library = shared_library(source, FLAGS)
+    if library is None:
+        return None
+    kernel = ctypes.CDLL(str(library))
+    kernel.sphere_check.restype = ctypes.c_int
+    kernel.sphere_check.argtypes = [ctypes.POINTER(_Model), ctypes.c_void_p, ctypes.c_int, ctypes.c_int,
+                                    ctypes.c_void_p, ctypes.c_void_p]
+    return kernel
+
+
+def collision_check(robot: Robot, scene: Scene, margin: float) -> SphereCheck | CoalCheck:
+    """The fastest yes/no collision test of `robot` in `scene` keeping `margin` (m) this machine can run."""
+    return CoalCheck(robot, scene, margin) if _kernel() is None else SphereCheck(robot, scene, margin)
+
+
+class SphereCheck:
+    """Collision tests of `robot` in `scene` keeping `margin` (m) of clearance (module docstring)."""
+
+    def __init__(self, robot: Robot, scene: Scene, margin: float) -> None:
+        self._kernel = _kernel()
+        if self._kernel is None:
+            raise RuntimeError("sphere_check.c did not compile: use collision_check, which falls back to coal")
+        self._arrays: list[np.ndarray] = []  # what the Model points to, kept alive with it
+        joints = joint_chain(robot)
+        order = np.argsort(robot.sphere_joint, kind="stable")  # the spheres in link order
+        place = np.empty_like(order)
+        place[order] = np.arange(len(order))
+        sphere_joint, offset, radius = robot.sphere_joint[order], robot.sphere_offset[order], robot.sphere_radius[order]
+        link_joint, link_first = np.unique(sphere_joint, return_index=True)
+        link_end = np.append(link_first[1:], len(order))
+        link_center = np.array([offset[a:b].mean(axis=0) for a, b in zip(link_first, link_end)]).reshape(-1, 3)
+        link_reach = np.array([(np.linalg.norm(offset[a:b] - c, axis=1) + radius[a:b]).max()
+                               for a, b, c in zip(link_first, link_end, link_center)])
+        link_of = np.searchsorted(link_joint, sphere_joint)  # each (ordered) sphere's link
+        pairs = np.sort(place[robot.self_collision], axis=1) if len(robot.self_collision) else np.zeros((0, 2), int)
+        pair_links = link_of[pairs]
+        pairs, pair_links = pairs[np.lexsort(pair_links.T[::-1])], pair_links[np.lexsort(pair_links.T[::-1])]
+        groups, pair_first = np.unique(pair_links, axis=0, return_index=True)
+        groups = groups.reshape(-1, 2)
+        kind, center, axes, half, bound = _obstacles(scene)
+        workspace = scene.workspace
+        self.model = _Model(
+            robot.model.nq, len(joints), self._ints([j.parent for j in joints]), self._ints([j.index for j in joints]),
+            self._ints([j.revolute for j in joints]), self._reals([j.rotation for j in joints]),
+            self._reals([j.cross for j in joints]), self._reals([j.cross_squared for j in joints]),
+            self._reals([j.translation for j in joints]), self._reals([j.slide for j in joints]),
+            len(order), self._ints(sphere_joint), self._reals(offset), self._reals(radius),
+            len(link_joint), self._ints(link_joint), self._ints(link_first), self._ints(link_end),
+            self._reals(link_center), self._reals(link_reach),
+            len(groups), self._ints(groups[:, 0]), self._ints(groups[:, 1]), self._ints(pair_first),
+            self._ints(np.append(pair_first[1:], len(pairs))), self._ints(pairs[:, 0]), self._ints(pairs[:, 1]),
+            len(kind), self._ints(kind), self._reals(center), self._reals(axes), self._reals(half),
+            self._reals(bound), int(workspace is not None),
+            self._reals(np.zeros(3) if workspace is None else workspace.lower),
+            self._reals(np.zeros(3) if workspace is None else workspace.upper), float(margin))
+        self._work = np.empty(12 * (len(joints) + 1) + 3 * (len(order) + len(link_joint)))
+        self._model_pointer = ctypes.byref(self.model)
+
+    def free(self, q: np.ndarray) -> np.ndarray:
+        """Whether each configuration of q (K, n) keeps the margin everywhere: shape (K,), bool."""
+        return ~self._collides(q, stop_at_first=False)[0]
+
+    def first_collision(self, q: np.ndarray) -> int | None:
+        """The index of the first configuration of q (K, n) that does not keep the margin, None if all do; the
+        ones after it are not checked."""
+        first = self._collides(q, stop_at_first=True)[1]
+        return None if first < 0 else first
+
+    def _collides(self, q: np.ndarray, stop_at_first: bool) -> tuple[np.ndarray, int]:
+        """Per configuration of q (K, n), whether it collides (bool (K,); with `stop_at_first` those after the
+        first that does are left False), and the first one's index (−1: none)."""
+        q = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+        hits = np.zeros(len(q), dtype=np.uint8)
+        first = self._kernel.sphere_check(self._model_pointer, q.ctypes.data, len(q), int(stop_at_first),
+                                          hits.ctypes.data, self._work.ctypes.data)
+        return hits.astype(bool), first
+
+    def _ints(self, values: object) -> ctypes.Array:
+        """A C int array of `values`, kept alive with this check."""
+        array = np.ascontiguousarray(values, dtype=np.intc).reshape(-1)
+        self._arrays.append(array)
+        return array.ctypes.data_as(_INT)
+
+    def _reals(self, values: object) -> ctypes.Array:
+        """A C double array of `values` (flattened row-major), kept alive with this check."""
+        array = np.ascontiguousarray(values, dtype=float).reshape(-1)
+        self._arrays.append(array)
+        return array.ctypes.data_as(_REAL)
+
+
+def _obstacles(scene: Scene) -> tuple[np.ndarray, ...]:
+    """Per obstacle (spheres, boxes, cylinders): kind (0, 1, 2), centre (O, 3), rotation (O, 9) row-major, half
+    sizes (O, 3) (sphere [radius, 0, 0], box half edges, cylinder [radius, length / 2, 0]), and the distance of
+    its farthest point from its centre (O,)."""
+    spheres, boxes, cylinders = len(scene.obstacle_radii), scene.boxes, scene.cylinders
+    half = np.concatenate([np.column_stack([scene.obstacle_radii, np.zeros((spheres, 2))]), 0.5 * boxes.sizes,
+                           np.column_stack([cylinders.radii, 0.5 * cylinders.lengths, np.zeros(len(cylinders))])])
+    bound = np.concatenate([scene.obstacle_radii, np.linalg.norm(0.5 * boxes.sizes, axis=1),
+                            np.hypot(cylinders.radii, 0.5 * cylinders.lengths)])
+    kind = np.repeat([0, 1, 2], [spheres, len(boxes), len(cylinders)])
+    center = np.concatenate([scene.obstacle_centers, boxes.centers, cylinders.centers]).reshape(-1, 3)
+    axes = np.concatenate([np.tile(np.eye(3).reshape(1, 9), (spheres, 1)), boxes.rotations.reshape(-1, 9),
+                           cylinders.rotations.reshape(-1, 9)])
+    return kind, center, axes, half.reshape(-1, 3), bound
