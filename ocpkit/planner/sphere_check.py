@@ -1,4 +1,4 @@
-"""The path search's collision test, compiled: the sphere model's yes/no answer in a few microseconds.
+"""The path search's collision test in compiled C: the sphere model's yes/no answer, one configuration after another.
 
 `SphereCheck(robot, scene, margin)` answers what `clearances(...) >= margin` answers (ocpkit.geometry.clearances,
 the verifier's model) for many configurations in one call, in C (sphere_check.c, compiled once per machine by
@@ -9,7 +9,7 @@ ocpkit.geometry.distance's. What makes it fast is what it does not test: the sph
 bounding sphere, and a link whose bound keeps clear of an obstacle, or of another link, skips all its spheres'
 tests against it; so does a sphere whose own distance to an obstacle's centre exceeds the obstacle's reach.
 Both skips are exact (a skipped pair's clearance is above the margin). `collision_check` returns it, or coal's
-test (ocpkit.geometry.coal_check, the same answers, ~4× slower) when there is no C compiler.
+test (ocpkit.geometry.coal_check: the same answers, slower) when there is no C compiler.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from __future__ import annotations
 import ctypes
 import functools
 from importlib import resources
+from typing import Any
 
 import numpy as np
 
@@ -83,9 +84,8 @@ class SphereCheck:
                                for a, b, c in zip(link_first, link_end, link_center)])
         link_of = np.searchsorted(link_joint, sphere_joint)  # each (ordered) sphere's link
         pairs = np.sort(place[robot.self_collision], axis=1) if len(robot.self_collision) else np.zeros((0, 2), int)
-        pair_links = link_of[pairs]
-        pairs, pair_links = pairs[np.lexsort(pair_links.T[::-1])], pair_links[np.lexsort(pair_links.T[::-1])]
-        groups, pair_first = np.unique(pair_links, axis=0, return_index=True)
+        pairs = pairs[np.lexsort(link_of[pairs].T[::-1])]  # grouped by link pair
+        groups, pair_first = np.unique(link_of[pairs], axis=0, return_index=True)
         groups = groups.reshape(-1, 2)
         kind, center, axes, half, bound = _obstacles(scene)
         workspace = scene.workspace
@@ -125,13 +125,13 @@ class SphereCheck:
                                           hits.ctypes.data, self._work.ctypes.data)
         return hits.astype(bool), first
 
-    def _ints(self, values: object) -> ctypes.Array:
+    def _ints(self, values: object) -> Any:
         """A C int array of `values`, kept alive with this check."""
         array = np.ascontiguousarray(values, dtype=np.intc).reshape(-1)
         self._arrays.append(array)
         return array.ctypes.data_as(_INT)
 
-    def _reals(self, values: object) -> ctypes.Array:
+    def _reals(self, values: object) -> Any:
         """A C double array of `values` (flattened row-major), kept alive with this check."""
         array = np.ascontiguousarray(values, dtype=float).reshape(-1)
         self._arrays.append(array)
