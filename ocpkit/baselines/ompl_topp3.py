@@ -32,8 +32,8 @@ from ocpkit.dynamics import Dynamics
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.path_spline import PathSpline
 from ocpkit.planner.build_cache import build
-from ocpkit.planner.ompl_seed import (MAX_STEP, check_ompl_planner, hold, import_backends, no_path_message, ompl_path,
-                                      planning_space, smooth_path, time_optimal)
+from ocpkit.planner.ompl_seed import (MAX_STEP, OMPL_PLANNER, check_ompl_planner, hold, import_backends,
+                                      no_path_message, ompl_path, planning_space, smooth_path, time_optimal)
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, Refined, solve_refined
 from ocpkit.problem import Problem
 from ocpkit.result import Hints, PathStats, Plan, Timing, finish
@@ -141,7 +141,7 @@ def plan_ompl_topp3(problem: Problem, transcription: str = "chebyshev", knots: i
                     dynamics: str | Dynamics = "casadi-rnea", solver: str = "ipopt",
                     refinements: int = DEFAULT_ROUNDS, transcription_options: dict | None = None,
                     solver_options: dict | None = None, dynamics_options: dict | None = None,
-                    max_wall_time: float = 60.0, planner_name: str = "rrtconnect", planning_time: float = 1.0,
+                    max_wall_time: float = 60.0, planner_name: str = OMPL_PLANNER, planning_time: float = 1.0,
                     seed: int = 0, resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
                     max_checks: int | None = None, max_step: float | None = MAX_STEP) -> Plan:
     """Plan `problem` by OMPL path, quintic smoothing and optimal timing along the path (module docstring).

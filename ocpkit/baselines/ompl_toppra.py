@@ -12,7 +12,8 @@ import time
 
 import numpy as np
 
-from ocpkit.planner.ompl_seed import MAX_STEP, SeedOptions, hold, ompl_path, ompl_seed, planning_space
+from ocpkit.planner.ompl_seed import (MAX_STEP, OMPL_PLANNER, SeedOptions, hold, ompl_path, ompl_seed,
+                                      planning_space)
 from ocpkit.problem import Problem
 from ocpkit.result import Hints, Plan, finish
 from ocpkit.verify import GEOMETRY_CHECKS
@@ -35,11 +36,12 @@ TOPPRA_HINTS = Hints(
 """What `ompl-toppra` can change: its path search, smoothing and TOPP-RA grid; the torque rate it cannot bound."""
 
 
-def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
+def plan_ompl_toppra(problem: Problem, planner_name: str = OMPL_PLANNER, planning_time: float = 1.0, seed: int = 0,
                      resolution: float = 0.01, grid_points: int = 1000, margin: float = 0.01,
                      max_checks: int | None = None, max_step: float | None = MAX_STEP) -> Plan:
     """Plan `problem` by path–velocity decomposition: OMPL path, smoothing, TOPP-RA (the options of
-    ocpkit.planner.ompl_seed.SeedOptions: `planner_name` one of OMPL_PLANNERS, `planning_time` s, `seed`,
+    ocpkit.planner.ompl_seed.SeedOptions: `planner_name` one of OMPL_PLANNERS (by default OMPL_PLANNER, the ladder's
+    OMPL rungs' search: RRTConnect, then LBKPIECE1), `planning_time` s, `seed`,
     `resolution` rad, `grid_points`, `margin` m, `max_checks`, `max_step` rad).
 
     Status: "verified" or "violated" (dense `verify`), "no_path" (OMPL found no exact path in its budget) or
@@ -58,7 +60,7 @@ def plan_ompl_toppra(problem: Problem, planner_name: str = "rrtconnect", plannin
                   message=seeded.message, timing=seeded.timing, path=seeded.path, hints=TOPPRA_HINTS)
 
 
-def joint_path(problem: Problem, planner_name: str = "rrtconnect", planning_time: float = 1.0, seed: int = 0,
+def joint_path(problem: Problem, planner_name: str = OMPL_PLANNER, planning_time: float = 1.0, seed: int = 0,
                resolution: float = 0.01, margin: float = 0.01, max_checks: int | None = None,
                max_step: float | None = MAX_STEP) -> np.ndarray | None:
     """The baseline's simplified collision-free joint-space path (waypoints (k, n), rad) from start to goal, or None

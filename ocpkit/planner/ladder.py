@@ -82,6 +82,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from ocpkit.formats.trajectory import Trajectory
+from ocpkit.planner.ompl_seed import OMPL_PLANNER
 from ocpkit.result import Plan, RungRow
 
 if TYPE_CHECKING:
@@ -92,7 +93,6 @@ FIRST_ITERATIONS = 100  # IPOPT iterations per solve of the first rung, from the
 MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the simultaneous planner's default
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
-OMPL_PLANNER = "rrtconnect-lbkpiece"  # an OMPL rung's path search (ocpkit.planner.ompl_seed.OMPL_PLANNERS)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
 PACE_ITERATIONS = 250  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
 RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take

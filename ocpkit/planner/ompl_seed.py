@@ -79,6 +79,8 @@ OMPL_PLANNERS = {"rrtconnect": ("RRTConnect",), "rrtstar": ("RRTstar",), "bitsta
                  "lbkpiece": ("LBKPIECE1",), "rrtconnect-lbkpiece": ("RRTConnect", "LBKPIECE1")}
 """OMPL's planners by name. A name with two runs the first until it has checked STAGE_CHECKS configurations
 without a path, then the second with what is left of the budget (`ompl_path`)."""
+OMPL_PLANNER = "rrtconnect-lbkpiece"
+"""The search by default: the ladder's OMPL rungs', the `ompl` guess's and the baselines'."""
 STAGE_CHECKS = 50_000
 REPAIR_ROUNDS = 8
 FRICTION_PASSES = 2
@@ -515,7 +517,7 @@ class SeedOptions:
     the search also ends then, whatever `planning_time` is left: a planner's budget, which counts the validity
     checker's construction (a second or more on a robot with thousands of sphere pairs) too."""
 
-    planner_name: str = "rrtconnect"
+    planner_name: str = OMPL_PLANNER
     planning_time: float = 1.0
     seed: int = 0
     resolution: float = 0.01

@@ -23,9 +23,8 @@ from ocpkit.nlp import Refinement
 from ocpkit.planner import GUESSES, PLANNERS, screening
 from ocpkit.planner.build_cache import Build, Shaped, layout, prepare, shape
 from ocpkit.planner.guesses import STRAIGHT_LINE_RULES
-from ocpkit.planner.ladder import (DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, Rung,
-                                   climb, ordered)
-from ocpkit.planner.ompl_seed import hold
+from ocpkit.planner.ladder import DEFAULT_LADDER, MAX_WALL_TIME, OMPL_CHECKS, OMPL_RESOLUTION, Rung, climb, ordered
+from ocpkit.planner.ompl_seed import OMPL_PLANNER, hold
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.refinement import DEFAULT_ROUNDS, RELAXED, Refined, solve_refined
 from ocpkit.problem import Problem

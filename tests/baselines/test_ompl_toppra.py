@@ -136,7 +136,7 @@ def test_case1_is_planned_from_rest_to_rest_and_only_the_torque_rate_fails(case1
     assert failed <= {"torque_rate"}  # TOPP-RA cannot bound it; everything else holds
     assert plan.status == ("verified" if not failed else "violated")
     assert case1.velocity_lower_bound() < plan.trajectory.tf < 2.0
-    assert plan.method == {"planner": "ompl-toppra", "path_planner": "rrtconnect", "grid_points": 1000}
+    assert plan.method == {"planner": "ompl-toppra", "path_planner": "rrtconnect-lbkpiece", "grid_points": 1000}
     path, timing = plan.stats.path, plan.stats.timing
     assert path.validity_checks > 0 and path.waypoints >= 2
     assert all(seconds > 0 for seconds in (timing.path_search, timing.simplify, timing.path_timing))

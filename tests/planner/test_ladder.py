@@ -23,8 +23,9 @@ from ocpkit.geometry.scene import Boxes
 from ocpkit.planner import GUESSES, PLANNERS
 from ocpkit.planner.guesses import ompl_guess
 from ocpkit.planner.ladder import (DEFAULT_LADDER, FINER_ITERATIONS, NET_KNOTS, NET_SEGMENTS, NO_PATH_HINT,
-                                   OMPL_CHECKS, OMPL_PLANNER, OMPL_RESOLUTION, PACE_ITERATIONS, RESERVE_SHARE,
+                                   OMPL_CHECKS, OMPL_RESOLUTION, PACE_ITERATIONS, RESERVE_SHARE,
                                    RUNG_SHARE, SINGLE_SHOT, Rung, climb, finer, finer_grid, ordered, rank)
+from ocpkit.planner.ompl_seed import OMPL_PLANNER
 from ocpkit.planner.options import SimultaneousOptions
 from ocpkit.planner.simultaneous import _timed_path, plan_simultaneous
 from ocpkit.result import Plan, PlanStats, RungRow, SolveTiming, Timing
