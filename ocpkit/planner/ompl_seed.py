@@ -70,8 +70,8 @@ import pinocchio as pin
 from ocpkit.errors import OptionError, RegistryError
 from ocpkit.formats.trajectory import Samples, Trajectory
 from ocpkit.geometry.clearances import clearances, sphere_centers
-from ocpkit.problem import Problem
 from ocpkit.planner.sphere_check import collision_check
+from ocpkit.problem import Problem
 from ocpkit.result import PathStats, Timing
 from ocpkit.robots import Robot, rigid_torque
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import ctypes
 import functools
+import warnings
 from importlib import resources
 from typing import Any
 
@@ -28,6 +29,7 @@ from ocpkit.robots import Robot
 from ocpkit.solvers.compiled import shared_library
 
 FLAGS = ("-O2", "-fPIC", "-shared")
+"""The kernel is small and compiled once per machine: optimized further than the generated code (-O1)."""
 _INT, _REAL = ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_double)
 
 
@@ -47,12 +49,18 @@ class _Model(ctypes.Structure):
 
 @functools.cache
 def _kernel() -> ctypes.CDLL | None:
-    """sphere_check.c's library, loaded once per process; None without a compiler."""
+    """sphere_check.c's library, loaded once per process; None (with a warning) when it cannot be compiled or
+    loaded."""
     source = resources.files("ocpkit.planner").joinpath("sphere_check.c").read_text()
     library = shared_library(source, FLAGS)
     if library is None:
         return None
-    kernel = ctypes.CDLL(str(library))
+    try:
+        kernel = ctypes.CDLL(str(library))
+    except OSError as exc:  # e.g. a library damaged on disk
+        warnings.warn(f"cannot load {library} (delete it to compile afresh): {exc}; the path search asks coal",
+                      stacklevel=2)
+        return None
     kernel.sphere_check.restype = ctypes.c_int
     kernel.sphere_check.argtypes = [ctypes.POINTER(_Model), ctypes.c_void_p, ctypes.c_int, ctypes.c_int,
                                     ctypes.c_void_p, ctypes.c_void_p]

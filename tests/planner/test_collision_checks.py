@@ -94,3 +94,15 @@ def test_without_a_compiler_the_search_asks_coal(monkeypatch):
     assert isinstance(collision_check(problem.robot, problem.scene, MARGIN), CoalCheck)
     with pytest.raises(RuntimeError, match="did not compile"):
         SphereCheck(problem.robot, problem.scene, MARGIN)
+
+
+def test_a_damaged_library_falls_back_to_coal_with_a_warning(monkeypatch, tmp_path):
+    damaged = tmp_path / "damaged.so"
+    damaged.write_bytes(b"not a library")
+    monkeypatch.setattr(sphere_check, "shared_library", lambda source, flags: damaged)
+    sphere_check._kernel.cache_clear()
+    try:
+        with pytest.warns(UserWarning, match="cannot load"):
+            assert sphere_check._kernel() is None
+    finally:
+        sphere_check._kernel.cache_clear()
