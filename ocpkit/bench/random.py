@@ -79,7 +79,8 @@ def random_problems(seed: int, count: int, obstacles: tuple[int, int] = (1, 1),
 
 def _passable(problem: Problem) -> bool:
     """Whether the room-to-pass certificate's search connects `problem`'s start and goal (module docstring)."""
-    return joint_path(problem, "rrtconnect", np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS, max_step=None) is not None
+    return joint_path(problem, planner_name="rrtconnect", planning_time=np.inf, seed=PATH_SEED, max_checks=PATH_CHECKS,
+                      max_step=None) is not None
 
 
 def _obstacles(rng: np.random.Generator, robot: Robot, start: np.ndarray, goal: np.ndarray,

@@ -59,6 +59,7 @@ def test_problems_without_room_to_pass_are_redrawn(monkeypatch):
     np.testing.assert_array_equal(redrawn[0].start, drawn[1].start)
     np.testing.assert_array_equal(redrawn[1].start, drawn[2].start)
     assert calls[0]["seed"] == suite.PATH_SEED and calls[0]["max_checks"] == suite.PATH_CHECKS
+    assert calls[0]["planner_name"] == "rrtconnect"  # the certificate's search, whatever the baselines' default
 
 
 @pytest.mark.slow
