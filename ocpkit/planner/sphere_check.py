@@ -153,8 +153,7 @@ def _obstacles(scene: Scene) -> tuple[np.ndarray, ...]:
     spheres, boxes, cylinders = len(scene.obstacle_radii), scene.boxes, scene.cylinders
     half = np.concatenate([np.column_stack([scene.obstacle_radii, np.zeros((spheres, 2))]), 0.5 * boxes.sizes,
                            np.column_stack([cylinders.radii, 0.5 * cylinders.lengths, np.zeros(len(cylinders))])])
-    bound = np.concatenate([scene.obstacle_radii, np.linalg.norm(0.5 * boxes.sizes, axis=1),
-                            np.hypot(cylinders.radii, 0.5 * cylinders.lengths)])
+    bound = np.concatenate([scene.obstacle_radii, boxes.bounding_radii(), cylinders.bounding_radii()])
     kind = np.repeat([0, 1, 2], [spheres, len(boxes), len(cylinders)])
     center = np.concatenate([scene.obstacle_centers, boxes.centers, cylinders.centers]).reshape(-1, 3)
     axes = np.concatenate([np.tile(np.eye(3).reshape(1, 9), (spheres, 1)), boxes.rotations.reshape(-1, 9),
