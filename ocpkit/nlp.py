@@ -11,6 +11,7 @@ between a Problem and these numbers belong to the transcription that built it (`
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -93,6 +94,9 @@ class PointCall:
     compiled: bool = False
     """Whether its derivatives are worth compiling to C: set for a function that depends on the robot and the OCP
     only (the dynamics rows), whose C is then the same for every problem of the robot (ocpkit.solvers.compiled)."""
+    constraint: Any = None
+    """The path constraint (ocpkit.constraints.Constraint) whose rows at a point's values these are, None for other
+    rows: a constraint may have its derivatives computed by hand (ocpkit.solvers.collision_derivatives)."""
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,7 @@ own margin and cap inside its group.
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
@@ -62,6 +63,20 @@ def active_terms(problem: Problem) -> tuple[np.ndarray, np.ndarray]:
         return obstacles, np.zeros((len(reach), 0), dtype=bool)
     faces = np.hstack([anchors - scene.workspace.lower, scene.workspace.upper - anchors])
     return obstacles, (faces <= span) & moving
+
+
+@dataclass(frozen=True)
+class Terms:
+    """The collision terms at one point in `SphereCollision.evaluate`'s order (the margin caps' order), the rows
+    they make and the workspace rows after them."""
+
+    kind: np.ndarray  # (T,): 0 a self-collision pair, 1 a sphere against an obstacle sphere, 2 a box, 3 a cylinder
+    first: np.ndarray  # (T,): the robot sphere (a pair's first)
+    second: np.ndarray  # (T,): a pair's second sphere, else the obstacle's index among its kind
+    groups: tuple[np.ndarray, ...]  # the terms of each row (one each unless `grouped`), in row order
+    face_sphere: np.ndarray  # (F,): each workspace row's sphere
+    face_axis: np.ndarray  # (F,): its axis (0 x, 1 y, 2 z)
+    face_sides: np.ndarray  # (F,): 1 the lower face, 2 the upper, 3 both
 
 
 class SphereCollision(Constraint):
@@ -155,39 +170,52 @@ class SphereCollision(Constraint):
                 "cylinder_rotation": cylinders.rotations.reshape(-1, 9),
                 "workspace": np.concatenate([np.zeros(0), *box]), "margin_cap": self.margin_caps(problem)}
 
+    def terms(self) -> Terms:
+        """The terms at one point in `evaluate`'s order, the rows they make and the workspace rows (Terms)."""
+        spheres, boxes, _ = self.counts
+        m, s = np.nonzero(self.obstacle_mask)
+        kinds = np.searchsorted([spheres, spheres + boxes], s, side="right")  # 0 sphere, 1 box, 2 cylinder
+        first_of_kind = np.array([0, spheres, spheres + boxes])
+        kind = np.concatenate([np.zeros(len(self.pairs), int), 1 + kinds])
+        first = np.concatenate([self.pairs[:, 0], m]).astype(int)
+        second = np.concatenate([self.pairs[:, 1], s - first_of_kind[kinds]]).astype(int)
+        joint = self.robot.sphere_joint
+        labels = [("self", joint[a], joint[b]) for a, b in self.pairs] + \
+            [("obstacle", joint[a], o) for a, o in zip(m, s)]
+        members: dict[tuple, list[int]] = {}
+        for index, label in enumerate(labels):
+            members.setdefault(label if self.grouped else index, []).append(index)
+        face_sphere, face_axis = self._face_rows()
+        sides = self.face_mask[face_sphere, face_axis] + 2 * self.face_mask[face_sphere, face_axis + 3]
+        return Terms(kind, first, second, tuple(np.asarray(v, dtype=int) for v in members.values()), face_sphere,
+                     face_axis, sides.astype(int))
+
     def evaluate(self, point: PointValues, context: Context) -> Rows:
         """Rows ≥ 0 (workspace rows of two faces ≤ 1), each term with the margin min(margin, its cap)
         (`margin_caps`); with `grouped`, one row per group of terms (module docstring)."""
         radius, p = self.robot.sphere_radius, context.parameters
-        margins = iter(ca.fmin(context.margin, p["margin_cap"][k]) for k in range(self.term_count))
+        margins = [ca.fmin(context.margin, p["margin_cap"][k]) for k in range(self.term_count)]
         centers = context.dynamics.sphere_centers(point.q)
-        joint = self.robot.sphere_joint
-        g, groups = [], []  # the terms in `margin_caps`' order, and the group of each
-        for a, b in self.pairs:
-            gap = centers[a, :] - centers[b, :]
-            g.append(ca.dot(gap, gap) - (radius[a] + radius[b] + next(margins)) ** 2)
-            groups.append(("self", joint[a], joint[b]))
-        spheres, boxes, _ = self.counts
-        for m, s in zip(*np.nonzero(self.obstacle_mask)):
-            if s < spheres:
-                gap = centers[m, :] - p["obstacle_center"][s, :]
-                g.append(ca.dot(gap, gap) - (radius[m] + p["obstacle_radius"][s] + next(margins)) ** 2)
+        terms = self.terms()
+        values = []
+        for index, (kind, a, b) in enumerate(zip(terms.kind, terms.first, terms.second)):
+            if kind <= 1:
+                other, reach = (centers[b, :], radius[b]) if kind == 0 else \
+                    (p["obstacle_center"][b, :], p["obstacle_radius"][b])
+                gap = centers[a, :] - other
+                values.append(ca.dot(gap, gap) - (radius[a] + reach + margins[index]) ** 2)
             else:
-                kind, k = ("box", s - spheres) if s < spheres + boxes else ("cylinder", s - spheres - boxes)
-                local = _local(centers[m, :], p[f"{kind}_center"][k, :], p[f"{kind}_rotation"][k, :])
-                outside = _outside_squared(local, p[f"{kind}_half_size"][k, :], kind == "cylinder")
-                g.append(outside - (radius[m] + next(margins)) ** 2)
-            groups.append(("obstacle", joint[m], s))
-        if self.grouped:
-            members: dict[tuple, list[ca.SX]] = {}
-            for group, term in zip(groups, g):
-                members.setdefault(group, []).append(term)
-            g = [soft_minimum(terms) for terms in members.values()]
+                name = "box" if kind == 2 else "cylinder"
+                local = _local(centers[a, :], p[f"{name}_center"][b, :], p[f"{name}_rotation"][b, :])
+                outside = _outside_squared(local, p[f"{name}_half_size"][b, :], kind == 3)
+                values.append(outside - (radius[a] + margins[index]) ** 2)
+        g = [soft_minimum([values[k] for k in group]) for group in terms.groups]
         upper = [np.inf] * len(g)
         box = p["workspace"]
-        for m, axis in zip(*self._face_rows()):
-            g.append(_workspace_row(box, centers[m, axis], radius[m] + next(margins), axis, self.face_mask[m]))
-            upper.append(1.0 if self.face_mask[m, axis] and self.face_mask[m, axis + 3] else np.inf)
+        for index, (m, axis, sides) in enumerate(zip(terms.face_sphere, terms.face_axis, terms.face_sides)):
+            g.append(_workspace_row(box, centers[m, axis], radius[m] + margins[len(values) + index], axis,
+                                    self.face_mask[m]))
+            upper.append(1.0 if sides == 3 else np.inf)
         g = ca.vertcat(*g) if g else ca.SX(0, 1)
         return Rows(g, np.zeros(g.numel()), np.asarray(upper, dtype=float))
 

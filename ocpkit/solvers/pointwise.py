@@ -25,8 +25,10 @@ point Hessian per point); the mapped call evaluates as fast. A parametric A_k(p)
 S_k B_k A_k(p) and A_k(p)ᵀ H_k A_k(p); the objective, when it is a point call, joins the same way with λ_f. Calls
 marked `compiled` (the dynamics rows: their point function depends on the robot and the OCP only, so its C is
 the same for every problem of a robot) run their point derivatives compiled to C (ocpkit.solvers.compiled),
-CasADi's virtual machine where nothing compiles. Calls with inputs not linear in x (a torque with friction, a
-path-timing OCP's jerk in its objective) take the SX graph.
+CasADi's virtual machine where nothing compiles. The collision rows' point derivatives are computed by hand in
+compiled C (ocpkit.solvers.collision_derivatives: the same for every problem, unlike their graph), mapped over their
+calls the same way. Calls with inputs not linear in x (a torque with friction, a path-timing OCP's jerk in its
+objective) take the SX graph.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ import scipy.sparse as sps
 
 from ocpkit.kept import Kept
 from ocpkit.nlp import NLP, PointCall
+from ocpkit.solvers.collision_derivatives import CollisionDerivatives, derivatives_by_hand
 from ocpkit.solvers.compiled import cache_directory, compiled, compiler
 
 T = TypeVar("T")
@@ -157,7 +160,10 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
         names = (f"jac_{len(marked)}", f"hess_{len(marked)}")  # the compiled ones named alike for every problem
         function, differentiated = calls[0][0].function, len(calls[0][0].inputs)
         make = functools.partial(_point_nonzeros, function, differentiated, names)
-        if compile and all(call.compiled for call, _ in calls):
+        by_hand = derivatives_by_hand(calls[0][0].constraint) if compile else None
+        if by_hand is not None:
+            derivatives.append(by_hand)
+        elif compile and all(call.compiled for call, _ in calls):
             marked.append(len(derivatives))
             derivatives.append(_made_once((function,), (differentiated, names), make))
         else:
@@ -169,11 +175,17 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
         derivatives[k] = [(f, sparsity) for f, (_, sparsity) in zip(pair, derivatives[k])]
     jacobians, hessians, jacobian_places, hessian_places = [], [], [], []
     jacobian_sums, hessian_sums = [], []  # the terms of calls with parametric A, as MX matrices
-    for calls, ((jacobian, jacobian_sparsity), (hessian, hessian_sparsity)) in zip(groups.values(), derivatives):
+    for calls, made in zip(groups.values(), derivatives):
         arguments = _mapped_arguments([call for call, _ in calls], x, p)(X, P)
         rows = [_rows(call) for call, _ in calls]
         weights = ca.reshape(lam_g[np.concatenate(rows).tolist()], -1, len(calls))
-        blocks = jacobian.map(len(calls))(*arguments), hessian.map(len(calls))(*arguments, weights)
+        if isinstance(made, CollisionDerivatives):  # mapped already
+            jacobian, hessian = made.mapped(calls[0][0].function, len(calls[0][0].inputs), len(calls))
+            jacobian_sparsity, hessian_sparsity = made.sparsities(_input_size(calls[0][0]))
+        else:
+            (point_jacobian, jacobian_sparsity), (point_hessian, hessian_sparsity) = made
+            jacobian, hessian = point_jacobian.map(len(calls)), point_hessian.map(len(calls))
+        blocks = jacobian(*arguments), hessian(*arguments, weights)
         constant = [k for k, (_, a) in enumerate(calls) if isinstance(a, sps.csr_matrix)]
         jacobians.append(ca.vec(blocks[0][:, constant]))
         hessians.append(ca.vec(blocks[1][:, constant]))
@@ -200,6 +212,11 @@ def _mapped_terms(nlp: NLP, mapped: list[tuple[PointCall, InputMap]],
                                                                                              ca.MX(n_x, n_x)))
     return (ca.Function("mapped_jacobian", [X, P], [jac]),
             ca.Function("mapped_hessian", [X, P, lam_f, lam_g], [hess]))
+
+
+def _input_size(call: PointCall) -> int:
+    """The length of z, the differentiated inputs of `call`'s point function stacked."""
+    return sum(call.function.numel_in(i) for i in range(len(call.inputs)))
 
 
 def _made_once(functions: tuple[ca.Function, ...], key: tuple, make: Callable[[], T]) -> T:

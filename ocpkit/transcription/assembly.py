@@ -182,12 +182,12 @@ class Assembly:
             function = ca.Function("point_rows", [*symbols, *parameters], [rows.g])
             self._point_rows[index] = function, rows.lower, rows.upper
         function, lower, upper = self._point_rows[index]
-        self._call(function, fields, parameters, lower, upper)
+        self._call(function, fields, parameters, lower, upper, constraint=None if by_node else self.constraints[index])
 
     def _call(self, function: ca.Function, inputs: tuple, parameters: tuple, lower: np.ndarray | float,
-              upper: np.ndarray | float, compiled: bool = False) -> None:
+              upper: np.ndarray | float, compiled: bool = False, constraint: Constraint | None = None) -> None:
         """The rows lower ≤ function(*inputs, *parameters) ≤ upper, recorded as a point call (see PointCall)."""
-        self.point_calls.append(PointCall(function, inputs, parameters, self.row_count, compiled))
+        self.point_calls.append(PointCall(function, inputs, parameters, self.row_count, compiled, constraint))
         self.add(Rows(function(*inputs, *parameters), lower, upper))
 
     # -- the result ----------------------------------------------------------------------------------
