@@ -3,14 +3,9 @@
  * A configuration collides when some clearance is below the margin: a self-collision pair, a sphere against an
  * obstacle (sphere, box or cylinder: the exact signed distance of ocpkit.geometry.distance) or against a workspace
  * face. Units: metres and radians; rotations row-major. */
-#include <math.h>
 
 typedef struct {
-    int dof;                                   /* q's length */
-    int joints;                                /* J: the model's joints 1..J (0 is the world) */
-    const int *parent, *index, *revolute;      /* (J,): parent joint, q index, 1 if revolute else prismatic */
-    const double *rotation, *cross, *cross_squared;  /* (J, 9): placement in the parent, [a]x, [a]x^2 */
-    const double *translation, *slide;         /* (J, 3): placement in the parent, prismatic axis in the parent */
+    Chain chain;                               /* the joints (ocpkit/solvers/chain.c, compiled before this file) */
     int spheres;                               /* M, in link order */
     const int *sphere_joint;                   /* (M,) */
     const double *offset, *radius;             /* (M, 3), (M,): centre in its joint's frame, radius */
@@ -30,42 +25,6 @@ typedef struct {
     const double *lower, *upper;               /* (3,) each */
     double margin;                             /* m */
 } Model;
-
-static void compose(const double *a, const double *b, double *out) { /* out = a b, 3 x 3 */
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            out[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
-}
-
-static void apply(const double *r, const double *t, const double *v, double *out) { /* out = r v + t */
-    for (int i = 0; i < 3; ++i)
-        out[i] = r[3 * i] * v[0] + r[3 * i + 1] * v[1] + r[3 * i + 2] * v[2] + t[i];
-}
-
-/* World rotation (J + 1, 9) and translation (J + 1, 3) of every joint at q: Rodrigues for a revolute joint. */
-static void kinematics(const Model *m, const double *q, double *rotation, double *translation) {
-    static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    for (int k = 0; k < 9; ++k) rotation[k] = eye[k];
-    translation[0] = translation[1] = translation[2] = 0.0;
-    for (int j = 1; j <= m->joints; ++j) {
-        const int p = m->parent[j - 1];
-        const double *placed = m->rotation + 9 * (j - 1), *parent = rotation + 9 * p;
-        double local[9], shift[3];
-        const double v = q[m->index[j - 1]];
-        for (int k = 0; k < 3; ++k) shift[k] = m->translation[3 * (j - 1) + k];
-        if (m->revolute[j - 1]) {
-            double turn[9], s = sin(v), c = 1.0 - cos(v);
-            for (int k = 0; k < 9; ++k)
-                turn[k] = eye[k] + s * m->cross[9 * (j - 1) + k] + c * m->cross_squared[9 * (j - 1) + k];
-            compose(placed, turn, local);
-        } else {
-            for (int k = 0; k < 9; ++k) local[k] = placed[k];
-            for (int k = 0; k < 3; ++k) shift[k] += v * m->slide[3 * (j - 1) + k];
-        }
-        compose(parent, local, rotation + 9 * j);
-        apply(parent, translation + 3 * p, shift, translation + 3 * j);
-    }
-}
 
 static double gap_squared(const double *a, const double *b) {
     const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
@@ -102,12 +61,13 @@ static int touches(const Model *m, int o, const double *c, double reach) {
     return reach > 0.0 && outside < reach * reach;
 }
 
-/* Whether configuration q collides; work holds (J + 1) 12 + (M + L) 3 doubles. Obstacles first, then the
+/* Whether configuration q collides; work holds (J + 1) 15 + (M + L) 3 doubles. Obstacles first, then the
  * workspace, then self-collision: a link (all its spheres) is passed over where its bound keeps clear. */
 static int collides(const Model *m, const double *q, double *work) {
-    double *rotation = work, *translation = work + 9 * (m->joints + 1);
-    double *centers = translation + 3 * (m->joints + 1), *links = centers + 3 * m->spheres;
-    kinematics(m, q, rotation, translation);
+    const int frames = m->chain.joints + 1;
+    double *rotation = work, *translation = work + 9 * frames, *axis = translation + 3 * frames;
+    double *centers = axis + 3 * frames, *links = centers + 3 * m->spheres;
+    kinematics(&m->chain, q, rotation, translation, axis);
     for (int s = 0; s < m->spheres; ++s) {
         const int j = m->sphere_joint[s];
         apply(rotation + 9 * j, translation + 3 * j, m->offset + 3 * s, centers + 3 * s);
@@ -149,7 +109,7 @@ int sphere_check(const Model *m, const double *q, int count, int stop_at_first, 
                  double *work) {
     int first = -1;
     for (int k = 0; k < count; ++k) {
-        hits[k] = (unsigned char)collides(m, q + (long)k * m->dof, work);
+        hits[k] = (unsigned char)collides(m, q + (long)k * m->chain.dof, work);
         if (hits[k] && first < 0) {
             first = k;
             if (stop_at_first) break;

@@ -1,70 +1,51 @@
 """The path search's collision test in compiled C: the sphere model's yes/no answer, one configuration after another.
 
 `SphereCheck(robot, scene, margin)` answers what `clearances(...) >= margin` answers (ocpkit.geometry.clearances,
-the verifier's model) for many configurations in one call, in C (sphere_check.c, compiled once per machine by
-ocpkit.solvers.compiled): the joints' poses by Rodrigues' formula from the model's placements (the joints
-`sphere_centers_batch` composes), the sphere centres, then every sphere against every obstacle and workspace face
-and every self-collision pair, stopping at the first clearance below the margin. The signed distances are
-ocpkit.geometry.distance's. What makes it fast is what it does not test: the spheres on one joint (a link) have a
-bounding sphere, and a link whose bound keeps clear of an obstacle, or of another link, skips all its spheres'
-tests against it; so does a sphere whose own distance to an obstacle's centre exceeds the obstacle's reach.
-Both skips are exact (a skipped pair's clearance is above the margin). `collision_check` returns it, or coal's
-test (ocpkit.geometry.coal_check: the same answers, slower) when there is no C compiler.
+the verifier's model) for many configurations in one call, in C (sphere_check.c after ocpkit/solvers/chain.c,
+compiled once per machine: ocpkit.solvers.chain): the joints' poses by Rodrigues' formula from the model's
+placements (the joints `sphere_centers_batch` composes), the sphere centres, then every sphere against every
+obstacle and workspace face and every self-collision pair, stopping at the first clearance below the margin. The
+signed distances are ocpkit.geometry.distance's. What makes it fast is what it does not test: the spheres on one
+joint (a link) have a bounding sphere, and a link whose bound keeps clear of an obstacle, or of another link, skips
+all its spheres' tests against it; so does a sphere whose own distance to an obstacle's centre exceeds the
+obstacle's reach. Both skips are exact (a skipped pair's clearance is above the margin). `collision_check` returns
+it, or coal's test (ocpkit.geometry.coal_check: the same answers, slower) when there is no C compiler.
 """
 
 from __future__ import annotations
 
 import ctypes
 import functools
-import warnings
-from importlib import resources
-from typing import Any
 
 import numpy as np
 
-from ocpkit.geometry.clearances import joint_chain
 from ocpkit.geometry.coal_check import CoalCheck
 from ocpkit.geometry.scene import Scene
 from ocpkit.robots import Robot
-from ocpkit.solvers.compiled import shared_library
-
-FLAGS = ("-O2", "-fPIC", "-shared")
-"""The kernel is small and compiled once per machine: optimized further than the generated code (-O1)."""
-_INT, _REAL = ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_double)
-
+from ocpkit.solvers.chain import INT, REAL, Chain, CArrays, chain, chain_work, kernel
 
 class _Model(ctypes.Structure):
     """sphere_check.c's Model, field for field."""
 
-    _fields_ = [("dof", ctypes.c_int), ("joints", ctypes.c_int), ("parent", _INT), ("index", _INT),
-                ("revolute", _INT), ("rotation", _REAL), ("cross", _REAL), ("cross_squared", _REAL),
-                ("translation", _REAL), ("slide", _REAL), ("spheres", ctypes.c_int), ("sphere_joint", _INT),
-                ("offset", _REAL), ("radius", _REAL), ("links", ctypes.c_int), ("link_joint", _INT),
-                ("link_first", _INT), ("link_end", _INT), ("link_center", _REAL), ("link_reach", _REAL),
-                ("link_pairs", ctypes.c_int), ("pair_link_a", _INT), ("pair_link_b", _INT), ("pair_first", _INT),
-                ("pair_end", _INT), ("pair_a", _INT), ("pair_b", _INT), ("obstacles", ctypes.c_int),
-                ("kind", _INT), ("center", _REAL), ("axes", _REAL), ("half", _REAL), ("bound", _REAL),
-                ("workspace", ctypes.c_int), ("lower", _REAL), ("upper", _REAL), ("margin", ctypes.c_double)]
+    _fields_ = [("chain", Chain), ("spheres", ctypes.c_int), ("sphere_joint", INT), ("offset", REAL),
+                ("radius", REAL), ("links", ctypes.c_int), ("link_joint", INT), ("link_first", INT),
+                ("link_end", INT), ("link_center", REAL), ("link_reach", REAL), ("link_pairs", ctypes.c_int),
+                ("pair_link_a", INT), ("pair_link_b", INT), ("pair_first", INT), ("pair_end", INT), ("pair_a", INT),
+                ("pair_b", INT), ("obstacles", ctypes.c_int), ("kind", INT), ("center", REAL), ("axes", REAL),
+                ("half", REAL), ("bound", REAL), ("workspace", ctypes.c_int), ("lower", REAL), ("upper", REAL),
+                ("margin", ctypes.c_double)]
 
 
 @functools.cache
 def _kernel() -> ctypes.CDLL | None:
-    """sphere_check.c's library, loaded once per process; None (with a warning) when it cannot be compiled or
-    loaded."""
-    source = resources.files("ocpkit.planner").joinpath("sphere_check.c").read_text()
-    library = shared_library(source, FLAGS)
-    if library is None:
-        return None
-    try:
-        kernel = ctypes.CDLL(str(library))
-    except OSError as exc:  # e.g. a library damaged on disk
-        warnings.warn(f"cannot load {library} (delete it to compile afresh): {exc}; the path search asks coal",
-                      stacklevel=2)
-        return None
-    kernel.sphere_check.restype = ctypes.c_int
-    kernel.sphere_check.argtypes = [ctypes.POINTER(_Model), ctypes.c_void_p, ctypes.c_int, ctypes.c_int,
-                                    ctypes.c_void_p, ctypes.c_void_p]
-    return kernel
+    """sphere_check.c's library (after chain.c), loaded once per process; None (with a warning) when it cannot be
+    compiled or loaded."""
+    library = kernel((("ocpkit.solvers", "chain.c"), ("ocpkit.planner", "sphere_check.c")), "the path search asks coal")
+    if library is not None:
+        library.sphere_check.restype = ctypes.c_int
+        library.sphere_check.argtypes = [ctypes.POINTER(_Model), ctypes.c_void_p, ctypes.c_int, ctypes.c_int,
+                                         ctypes.c_void_p, ctypes.c_void_p]
+    return library
 
 
 def collision_check(robot: Robot, scene: Scene, margin: float) -> SphereCheck | CoalCheck:
@@ -79,8 +60,7 @@ class SphereCheck:
         self._kernel = _kernel()
         if self._kernel is None:
             raise RuntimeError("sphere_check.c did not compile: use collision_check, which falls back to coal")
-        self._arrays: list[np.ndarray] = []  # what the Model points to, kept alive with it
-        joints = joint_chain(robot)
+        arrays = self._arrays = CArrays()  # what the Model points to, kept alive with it
         order = np.argsort(robot.sphere_joint, kind="stable")  # the spheres in link order
         place = np.empty_like(order)
         place[order] = np.arange(len(order))
@@ -98,20 +78,16 @@ class SphereCheck:
         kind, center, axes, half, bound = _obstacles(scene)
         workspace = scene.workspace
         self.model = _Model(
-            robot.model.nq, len(joints), self._ints([j.parent for j in joints]), self._ints([j.index for j in joints]),
-            self._ints([j.revolute for j in joints]), self._reals([j.rotation for j in joints]),
-            self._reals([j.cross for j in joints]), self._reals([j.cross_squared for j in joints]),
-            self._reals([j.translation for j in joints]), self._reals([j.slide for j in joints]),
-            len(order), self._ints(sphere_joint), self._reals(offset), self._reals(radius),
-            len(link_joint), self._ints(link_joint), self._ints(link_first), self._ints(link_end),
-            self._reals(link_center), self._reals(link_reach),
-            len(groups), self._ints(groups[:, 0]), self._ints(groups[:, 1]), self._ints(pair_first),
-            self._ints(np.append(pair_first[1:], len(pairs))), self._ints(pairs[:, 0]), self._ints(pairs[:, 1]),
-            len(kind), self._ints(kind), self._reals(center), self._reals(axes), self._reals(half),
-            self._reals(bound), int(workspace is not None),
-            self._reals(np.zeros(3) if workspace is None else workspace.lower),
-            self._reals(np.zeros(3) if workspace is None else workspace.upper), float(margin))
-        self._work = np.empty(12 * (len(joints) + 1) + 3 * (len(order) + len(link_joint)))
+            chain(robot, arrays), len(order), arrays.ints(sphere_joint), arrays.reals(offset), arrays.reals(radius),
+            len(link_joint), arrays.ints(link_joint), arrays.ints(link_first), arrays.ints(link_end),
+            arrays.reals(link_center), arrays.reals(link_reach),
+            len(groups), arrays.ints(groups[:, 0]), arrays.ints(groups[:, 1]), arrays.ints(pair_first),
+            arrays.ints(np.append(pair_first[1:], len(pairs))), arrays.ints(pairs[:, 0]), arrays.ints(pairs[:, 1]),
+            len(kind), arrays.ints(kind), arrays.reals(center), arrays.reals(axes), arrays.reals(half),
+            arrays.reals(bound), int(workspace is not None),
+            arrays.reals(np.zeros(3) if workspace is None else workspace.lower),
+            arrays.reals(np.zeros(3) if workspace is None else workspace.upper), float(margin))
+        self._work = np.empty(chain_work(robot) + 3 * (len(order) + len(link_joint)))
         self._model_pointer = ctypes.byref(self.model)
 
     def free(self, q: np.ndarray) -> np.ndarray:
@@ -132,18 +108,6 @@ class SphereCheck:
         first = self._kernel.sphere_check(self._model_pointer, q.ctypes.data, len(q), int(stop_at_first),
                                           hits.ctypes.data, self._work.ctypes.data)
         return hits.astype(bool), first
-
-    def _ints(self, values: object) -> Any:
-        """A C int array of `values`, kept alive with this check."""
-        array = np.ascontiguousarray(values, dtype=np.intc).reshape(-1)
-        self._arrays.append(array)
-        return array.ctypes.data_as(_INT)
-
-    def _reals(self, values: object) -> Any:
-        """A C double array of `values` (flattened row-major), kept alive with this check."""
-        array = np.ascontiguousarray(values, dtype=float).reshape(-1)
-        self._arrays.append(array)
-        return array.ctypes.data_as(_REAL)
 
 
 def _obstacles(scene: Scene) -> tuple[np.ndarray, ...]:

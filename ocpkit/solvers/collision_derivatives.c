@@ -11,15 +11,9 @@
  * a_j1 x (column j2) if j1 is revolute, else 0. A soft minimum r = -log(sum exp(-beta t_i)) / beta has weights
  * sigma_i = dr/dt_i (summing to 1) and hess_q r = sum sigma_i hess_q t_i + beta (gg^T - sum sigma_i g_i g_i^T),
  * g = sum sigma_i g_i, g_i = grad_q t_i. Units: metres and radians; rotations row-major. */
-#include <math.h>
-#include <string.h>
 
 typedef struct {
-    int dof;                                   /* q's length */
-    int joints;                                /* J: the model's joints 1..J (0 is the world) */
-    const int *parent, *index, *revolute;      /* (J,): parent joint, q index, 1 if revolute else prismatic */
-    const double *rotation, *cross, *cross_squared;  /* (J, 9): placement in the parent, [a]x, [a]x^2 */
-    const double *translation, *slide;         /* (J, 3): placement in the parent, axis in the parent */
+    Chain chain;                               /* the joints (chain.c, compiled before this file) */
     int spheres;
     const int *sphere_joint;                   /* (M,) */
     const double *offset, *radius;             /* (M, 3), (M,): centre in its joint's frame, radius */
@@ -44,17 +38,6 @@ typedef struct {                               /* the NLP parameters' values */
     const double *workspace;                   /* (6,): lower, upper */
 } Scene;
 
-static void compose(const double *a, const double *b, double *out) { /* out = a b, 3 x 3 */
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            out[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
-}
-
-static void apply(const double *r, const double *t, const double *v, double *out) { /* out = r v + t */
-    for (int i = 0; i < 3; ++i)
-        out[i] = r[3 * i] * v[0] + r[3 * i + 1] * v[1] + r[3 * i + 2] * v[2] + t[i];
-}
-
 static void cross(const double *a, const double *b, double *out) {
     out[0] = a[1] * b[2] - a[2] * b[1];
     out[1] = a[2] * b[0] - a[0] * b[2];
@@ -63,43 +46,15 @@ static void cross(const double *a, const double *b, double *out) {
 
 static double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 
-/* Every joint's world rotation (J + 1, 9), origin (J + 1, 3) and axis (J + 1, 3) at q. */
-static void kinematics(const Model *m, const double *q, double *rotation, double *origin, double *axis) {
-    static const double eye[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-    memcpy(rotation, eye, sizeof eye);
-    memset(origin, 0, 3 * sizeof(double));
-    memset(axis, 0, 3 * sizeof(double));
-    for (int j = 1; j <= m->joints; ++j) {
-        const int p = m->parent[j - 1];
-        const double *placed = m->rotation + 9 * (j - 1), *up = rotation + 9 * p, *slide = m->slide + 3 * (j - 1);
-        double local[9], shift[3];
-        const double v = q[m->index[j - 1]];
-        for (int k = 0; k < 3; ++k) shift[k] = m->translation[3 * (j - 1) + k];
-        if (m->revolute[j - 1]) {
-            double turn[9], s = sin(v), c = 1.0 - cos(v);
-            for (int k = 0; k < 9; ++k)
-                turn[k] = eye[k] + s * m->cross[9 * (j - 1) + k] + c * m->cross_squared[9 * (j - 1) + k];
-            compose(placed, turn, local);
-        } else {
-            memcpy(local, placed, sizeof local);
-            for (int k = 0; k < 3; ++k) shift[k] += v * slide[k];
-        }
-        compose(up, local, rotation + 9 * j);
-        apply(up, origin + 3 * p, shift, origin + 3 * j);
-        static const double none[3] = {0, 0, 0};
-        apply(up, none, slide, axis + 3 * j);
-    }
-}
-
 /* Sphere s's centre (3,) and Jacobian (3, dof), column-major, zero where a joint does not move it. */
 static void sphere_jacobian(const Model *m, int s, const double *rotation, const double *origin,
                             const double *axis, double *center, double *jacobian) {
     int j = m->sphere_joint[s];
     apply(rotation + 9 * j, origin + 3 * j, m->offset + 3 * s, center);
-    memset(jacobian, 0, 3 * m->dof * sizeof(double));
-    for (; j > 0; j = m->parent[j - 1]) {
-        double *column = jacobian + 3 * m->index[j - 1];
-        if (m->revolute[j - 1]) {
+    memset(jacobian, 0, 3 * m->chain.dof * sizeof(double));
+    for (; j > 0; j = m->chain.parent[j - 1]) {
+        double *column = jacobian + 3 * m->chain.index[j - 1];
+        if (m->chain.revolute[j - 1]) {
             double arm[3] = {center[0] - origin[3 * j], center[1] - origin[3 * j + 1], center[2] - origin[3 * j + 2]};
             cross(axis + 3 * j, arm, column);
         } else {
@@ -111,14 +66,14 @@ static void sphere_jacobian(const Model *m, int s, const double *rotation, const
 /* w^T hess_q c_s added to hess (dof, dof) for sphere s with Jacobian `jacobian` (3, dof) (file comment). */
 static void add_curvature(const Model *m, int s, const double *axis, const double *jacobian, const double *w,
                           double *hess) {
-    const int n = m->dof;
-    for (int j1 = m->sphere_joint[s]; j1 > 0; j1 = m->parent[j1 - 1]) {
-        if (!m->revolute[j1 - 1]) continue;
+    const int n = m->chain.dof;
+    for (int j1 = m->sphere_joint[s]; j1 > 0; j1 = m->chain.parent[j1 - 1]) {
+        if (!m->chain.revolute[j1 - 1]) continue;
         double u[3];
         cross(w, axis + 3 * j1, u);  /* w . (a x v) = v . (w x a) */
-        const int k1 = m->index[j1 - 1];
-        for (int j2 = m->sphere_joint[s];; j2 = m->parent[j2 - 1]) {
-            const int k2 = m->index[j2 - 1];
+        const int k1 = m->chain.index[j1 - 1];
+        for (int j2 = m->sphere_joint[s];; j2 = m->chain.parent[j2 - 1]) {
+            const int k2 = m->chain.index[j2 - 1];
             const double *v = jacobian + 3 * k2;
             const double value = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
             hess[k1 * n + k2] += value;
@@ -196,19 +151,19 @@ static double term(const Model *m, const Scene *sc, int i, const double *centers
 
 /* The derivatives at `count` points q (count, dof): jac (count, rows, dof), each point's rows x dof column-major;
  * with lam (count, rows) also hess (count, dof, dof): the Hessian of lam^T rows. Either output may be NULL. work
- * holds (J + 1) 15 + M (3 + 6 dof) + 3 dof^2... (collision_derivatives.py sizes it). */
+ * holds 15 (J + 1) + M (6 + 3 dof) + T + 8 dof doubles. */
 void collision_derivatives(const Model *m, const Scene *sc, const double *q, int count, const double *lam,
                            double *jac, double *hess, double *work) {
-    const int n = m->dof, rows = m->groups + m->faces;
-    double *rotation = work, *origin = rotation + 9 * (m->joints + 1), *axis = origin + 3 * (m->joints + 1);
-    double *centers = axis + 3 * (m->joints + 1), *jacobians = centers + 3 * m->spheres;
+    const int n = m->chain.dof, rows = m->groups + m->faces, frames = m->chain.joints + 1;
+    double *rotation = work, *origin = rotation + 9 * frames, *axis = origin + 3 * frames;
+    double *centers = axis + 3 * frames, *jacobians = centers + 3 * m->spheres;
     double *weights = jacobians + 3 * n * m->spheres, *values = weights + 3 * m->spheres;
     double *joined = values + m->terms, *gradient = joined + 3 * n, *sum = gradient + n, *scaled = sum + n;
     for (int point = 0; point < count; ++point) {
         double *jac_point = jac ? jac + (long)point * rows * n : 0;
         double *hess_point = hess ? hess + (long)point * n * n : 0;
         const double *lam_point = lam ? lam + (long)point * rows : 0;
-        kinematics(m, q + (long)point * n, rotation, origin, axis);
+        kinematics(&m->chain, q + (long)point * n, rotation, origin, axis);
         for (int s = 0; s < m->spheres; ++s)
             sphere_jacobian(m, s, rotation, origin, axis, centers + 3 * s, jacobians + 3 * n * s);
         if (hess_point) {

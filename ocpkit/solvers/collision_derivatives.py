@@ -17,8 +17,7 @@ from __future__ import annotations
 
 import ctypes
 import functools
-import warnings
-from importlib import resources
+import weakref
 from typing import Any
 
 import casadi as ca
@@ -27,60 +26,55 @@ import numpy as np
 from ocpkit.constraints import Constraint
 from ocpkit.constraints.collision import RADIAL_EPS, SOFTMIN_SHARPNESS, SphereCollision
 from ocpkit.geometry.clearances import joint_chain
-from ocpkit.solvers.compiled import shared_library
-
-FLAGS = ("-O2", "-fPIC", "-shared")
-"""Small hand-written C compiled once per machine: optimized further than generated code (-O1)."""
-_INT, _REAL = ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_double)
-
+from ocpkit.robots import Robot
+from ocpkit.solvers.chain import INT, REAL, Chain, CArrays, chain, chain_work, kernel
 
 class _Model(ctypes.Structure):
     """collision_derivatives.c's Model, field for field."""
 
-    _fields_ = [("dof", ctypes.c_int), ("joints", ctypes.c_int), ("parent", _INT), ("index", _INT),
-                ("revolute", _INT), ("rotation", _REAL), ("cross", _REAL), ("cross_squared", _REAL),
-                ("translation", _REAL), ("slide", _REAL), ("spheres", ctypes.c_int), ("sphere_joint", _INT),
-                ("offset", _REAL), ("radius", _REAL), ("terms", ctypes.c_int), ("kind", _INT), ("first", _INT),
-                ("second", _INT), ("groups", ctypes.c_int), ("group_start", _INT), ("group_terms", _INT),
-                ("faces", ctypes.c_int), ("face_sphere", _INT), ("face_axis", _INT), ("face_sides", _INT),
-                ("sharpness", ctypes.c_double), ("radial_eps", ctypes.c_double)]
+    _fields_ = [("chain", Chain), ("spheres", ctypes.c_int), ("sphere_joint", INT), ("offset", REAL),
+                ("radius", REAL), ("terms", ctypes.c_int), ("kind", INT), ("first", INT), ("second", INT),
+                ("groups", ctypes.c_int), ("group_start", INT), ("group_terms", INT), ("faces", ctypes.c_int),
+                ("face_sphere", INT), ("face_axis", INT), ("face_sides", INT), ("sharpness", ctypes.c_double),
+                ("radial_eps", ctypes.c_double)]
 
 
 class _Scene(ctypes.Structure):
     """collision_derivatives.c's Scene, field for field."""
 
-    _fields_ = [("margin", ctypes.c_double), ("cap", _REAL), *((name, _REAL) for name in (
+    _fields_ = [("margin", ctypes.c_double), ("cap", REAL), *((name, REAL) for name in (
         "sphere_center", "sphere_radius", "box_center", "box_half", "box_rotation", "cylinder_center",
         "cylinder_half", "cylinder_rotation", "workspace"))]
 
 
+_MADE: weakref.WeakKeyDictionary[SphereCollision, CollisionDerivatives] = weakref.WeakKeyDictionary()
+"""Each constraint's derivatives while the constraint lives: CasADi calls back into their Python objects (`_Mapped`),
+which must outlive the solver's Functions that call them, and the constraint does (the NLP's point calls hold it,
+and the prepared solver holds the NLP)."""
+
+
 @functools.cache
 def _kernel() -> ctypes.CDLL | None:
-    """collision_derivatives.c's library, loaded once per process; None (with a warning) when it cannot be
-    compiled or loaded."""
-    source = resources.files("ocpkit.solvers").joinpath("collision_derivatives.c").read_text()
-    library = shared_library(source, FLAGS)
-    if library is None:
-        return None
-    try:
-        kernel = ctypes.CDLL(str(library))
-    except OSError as exc:  # e.g. a library damaged on disk
-        warnings.warn(f"cannot load {library} (delete it to compile afresh): {exc}; CasADi differentiates the "
-                      "collision rows", stacklevel=2)
-        return None
-    kernel.collision_derivatives.restype = None
-    kernel.collision_derivatives.argtypes = [ctypes.POINTER(_Model), ctypes.POINTER(_Scene), ctypes.c_void_p,
-                                             ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
-                                             ctypes.c_void_p]
-    return kernel
+    """collision_derivatives.c's library (after chain.c), loaded once per process; None (with a warning) when it
+    cannot be compiled or loaded."""
+    library = kernel((("ocpkit.solvers", "chain.c"), ("ocpkit.solvers", "collision_derivatives.c")),
+                     "CasADi differentiates the collision rows")
+    if library is not None:
+        library.collision_derivatives.restype = None
+        library.collision_derivatives.argtypes = [ctypes.POINTER(_Model), ctypes.POINTER(_Scene), ctypes.c_void_p,
+                                                  ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+                                                  ctypes.c_void_p]
+    return library
 
 
 def derivatives_by_hand(constraint: Constraint | None) -> CollisionDerivatives | None:
     """The compiled derivatives of `constraint`'s rows: for a SphereCollision where the C compiles, else None
-    (CasADi's then)."""
+    (CasADi's then). They live as long as the constraint (`_MADE`)."""
     if not isinstance(constraint, SphereCollision) or _kernel() is None:
         return None
-    return CollisionDerivatives(constraint)
+    if constraint not in _MADE:
+        _MADE[constraint] = CollisionDerivatives(constraint)
+    return _MADE[constraint]
 
 
 class CollisionDerivatives:
@@ -88,25 +82,20 @@ class CollisionDerivatives:
 
     def __init__(self, constraint: SphereCollision) -> None:
         self._kernel = _kernel()
-        self._arrays: list[np.ndarray] = []  # what the Model points to, kept alive with it
-        robot, terms = constraint.robot, constraint.terms()
-        joints = joint_chain(robot)
+        self._arrays = CArrays()  # what the Model points to, kept alive with it
+        robot, terms, arrays = constraint.robot, constraint.terms(), self._arrays
         self.dof, self.rows = robot.model.nq, len(terms.groups) + len(terms.face_sphere)
         starts = np.cumsum([0, *map(len, terms.groups)])
         members = np.concatenate([np.zeros(0, int), *terms.groups])
         self.model = _Model(
-            self.dof, len(joints), self._ints([j.parent for j in joints]), self._ints([j.index for j in joints]),
-            self._ints([j.revolute for j in joints]), self._reals([j.rotation for j in joints]),
-            self._reals([j.cross for j in joints]), self._reals([j.cross_squared for j in joints]),
-            self._reals([j.translation for j in joints]), self._reals([j.slide for j in joints]),
-            len(robot.sphere_radius), self._ints(robot.sphere_joint), self._reals(robot.sphere_offset),
-            self._reals(robot.sphere_radius), len(terms.kind), self._ints(terms.kind), self._ints(terms.first),
-            self._ints(terms.second), len(terms.groups), self._ints(starts), self._ints(members),
-            len(terms.face_sphere), self._ints(terms.face_sphere), self._ints(terms.face_axis),
-            self._ints(terms.face_sides), SOFTMIN_SHARPNESS, RADIAL_EPS)
-        self._work = np.empty(15 * (len(joints) + 1) + len(robot.sphere_radius) * (6 + 3 * self.dof)
-                              + len(terms.kind) + 8 * self.dof)
-        moved = _moved_by(robot.sphere_joint, joints, self.dof)  # (M, dof): which joints move each sphere
+            chain(robot, arrays), len(robot.sphere_radius), arrays.ints(robot.sphere_joint),
+            arrays.reals(robot.sphere_offset), arrays.reals(robot.sphere_radius), len(terms.kind),
+            arrays.ints(terms.kind), arrays.ints(terms.first), arrays.ints(terms.second), len(terms.groups),
+            arrays.ints(starts), arrays.ints(members), len(terms.face_sphere), arrays.ints(terms.face_sphere),
+            arrays.ints(terms.face_axis), arrays.ints(terms.face_sides), SOFTMIN_SHARPNESS, RADIAL_EPS)
+        self._work = np.empty(chain_work(robot) + len(robot.sphere_radius) * (6 + 3 * self.dof) + len(terms.kind)
+                              + 8 * self.dof)
+        moved = _moved_by(robot, self.dof)  # (M, dof): which joints move each sphere
         depends = np.zeros((self.rows, self.dof), dtype=bool)
         for row, group in enumerate(terms.groups):
             pairs = terms.kind[group] == 0
@@ -130,9 +119,9 @@ class CollisionDerivatives:
         `sparsities`' order. `function` is the constraint's point function: its first `differentiated` inputs are
         the point's values, q first, then the margin, the limit scale and the constraint's parameters
         (ocpkit.transcription.assembly)."""
-        key = (id(function), differentiated, calls)
+        shapes = [(function.size1_in(i), function.size2_in(i) * calls) for i in range(function.n_in())]
+        key = (tuple(shapes), differentiated, calls)
         if key not in self._mapped:
-            shapes = [(function.size1_in(i), function.size2_in(i) * calls) for i in range(function.n_in())]
             self._mapped[key] = tuple(_Mapped(self, shapes, differentiated, calls, hessian) for hessian in
                                       (False, True))
         return self._mapped[key]
@@ -152,23 +141,12 @@ class CollisionDerivatives:
                                            lam.ctypes.data, None, out.ctypes.data, self._work.ctypes.data)
         return out[:, self.hessian_columns, self.hessian_rows]
 
-    def _ints(self, values: object) -> Any:
-        """A C int array of `values`, kept alive with this object."""
-        array = np.ascontiguousarray(values, dtype=np.intc).reshape(-1)
-        self._arrays.append(array)
-        return array.ctypes.data_as(_INT)
 
-    def _reals(self, values: object) -> Any:
-        """A C double array of `values` (flattened row-major), kept alive with this object."""
-        array = np.ascontiguousarray(values, dtype=float).reshape(-1)
-        self._arrays.append(array)
-        return array.ctypes.data_as(_REAL)
-
-
-def _moved_by(sphere_joint: np.ndarray, joints: tuple, dof: int) -> np.ndarray:
+def _moved_by(robot: Robot, dof: int) -> np.ndarray:
     """(M, dof): whether q[k] moves sphere m (k is the index of a joint on the chain from m's joint to the world)."""
-    moved = np.zeros((len(sphere_joint), dof), dtype=bool)
-    for m, joint in enumerate(sphere_joint.tolist()):
+    joints = joint_chain(robot)
+    moved = np.zeros((len(robot.sphere_joint), dof), dtype=bool)
+    for m, joint in enumerate(robot.sphere_joint.tolist()):
         while joint > 0:
             moved[m, joints[joint - 1].index] = True
             joint = joints[joint - 1].parent
@@ -204,12 +182,10 @@ class _Mapped(ca.Callback):
         values = [np.asarray(a.full()) for a in arguments]
         first = self.differentiated  # the margin; the limit scale, then the constraint's parameters follow
         parameters = {name: values[first + 2 + k] for k, name in enumerate(self.derivatives.parameters)}
-        kept = []  # the arrays the Scene points to, alive through the call
+        arrays = CArrays()  # what the Scene points to, alive through the call
 
         def reals(name: str, width: int) -> Any:
-            array = np.ascontiguousarray(parameters[name][:, :width], dtype=float)  # the first call's columns
-            kept.append(array)
-            return array.ctypes.data_as(_REAL)
+            return arrays.reals(parameters[name][:, :width])  # the first call's columns: every call's are the same
 
         scene = _Scene(float(values[first][0, 0]), reals("margin_cap", 1), reals("obstacle_center", 3),
                        reals("obstacle_radius", 1), reals("box_center", 3), reals("box_half_size", 3),

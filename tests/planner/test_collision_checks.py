@@ -17,6 +17,7 @@ from ocpkit.geometry.coal_check import CoalCheck
 from ocpkit.geometry.scene import Boxes, Scene
 from ocpkit.planner import sphere_check
 from ocpkit.planner.sphere_check import SphereCheck, collision_check
+from ocpkit.solvers import chain
 
 MARGIN = 0.01
 CHECKS = {"compiled": SphereCheck, "coal": CoalCheck}
@@ -99,7 +100,7 @@ def test_without_a_compiler_the_search_asks_coal(monkeypatch):
 def test_a_damaged_library_falls_back_to_coal_with_a_warning(monkeypatch, tmp_path):
     damaged = tmp_path / "damaged.so"
     damaged.write_bytes(b"not a library")
-    monkeypatch.setattr(sphere_check, "shared_library", lambda source, flags: damaged)
+    monkeypatch.setattr(chain, "shared_library", lambda source, flags: damaged)
     sphere_check._kernel.cache_clear()
     try:
         with pytest.warns(UserWarning, match="cannot load"):

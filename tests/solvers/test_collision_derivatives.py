@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import gc
 
 import casadi as ca
 import numpy as np
@@ -16,8 +17,12 @@ from helpers import REPO
 import ocpkit
 from ocpkit.constraints import Context, PointValues
 from ocpkit.constraints.collision import SphereCollision
+from ocpkit.nlp import Refinement
+from ocpkit.planner import screening
+from ocpkit.planner.build_cache import shape
 from ocpkit.solvers import collision_derivatives
 from ocpkit.solvers.collision_derivatives import CollisionDerivatives, derivatives_by_hand
+from ocpkit.solvers.pointwise import pointwise_derivatives
 from ocpkit.dynamics import make_dynamics
 from ocpkit.geometry.quaternion import quaternion_matrix
 from ocpkit.geometry.scene import Boxes, Cylinders, Scene
@@ -127,3 +132,22 @@ def test_without_a_compiler_casadi_differentiates_the_rows(monkeypatch):
     assert isinstance(derivatives_by_hand(SphereCollision(PAPER)), CollisionDerivatives)
     monkeypatch.setattr(collision_derivatives, "_kernel", lambda: None)
     assert derivatives_by_hand(SphereCollision(PAPER)) is None
+
+
+def test_the_solvers_derivatives_outlive_the_objects_that_made_them():
+    """CasADi calls back into Python objects that nothing but the NLP's constraint keeps: they must survive a
+    garbage collection for as long as the NLP does, and go with it."""
+    problem = MBM
+    discretization = shape(problem, near=screening.line_samples(problem)).discretization
+    nlp = discretization.nlp
+    derivatives = pointwise_derivatives(nlp)
+    gc.collect()
+    x = np.random.default_rng(8).uniform(-0.2, 0.2, nlp.x.numel())
+    x[nlp.variables.index("tf")] = 1.5
+    parameters = discretization.parameters(problem, Refinement())
+    hessian = derivatives["hess_lag"](x, parameters, 1.0, np.ones(nlp.g.numel()))
+    assert np.isfinite(np.asarray(ca.DM(hessian).nonzeros())).all()
+    made = len(collision_derivatives._MADE)
+    del discretization, nlp, derivatives
+    gc.collect()
+    assert len(collision_derivatives._MADE) < made
