@@ -58,12 +58,13 @@ bound where TOPP-RA times the same path well within it.
 
 An OMPL rung's first solve keeps a pace (PACE_ITERATIONS): it stops as soon as that many iterations, at the pace
 of its iterations so far, would not end within the rung's time. That many is what a rung's solves may take in
-all, its refinement rounds included, on a plan that verifies (most take far fewer; a large NLP, the Fetch's, can
-run that many without verifying): a rung that could not do that much work in its time would end at its time
-limit, most often unverified. Where an iteration is slow (a large NLP: the Fetch's thousands
-of self-collision rows) it gives that time to the safety net, which times the same path, instead (no screening
-rebuild follows a solve stopped by time: ocpkit.planner.simultaneous, and its motion is not verified:
-ocpkit.planner.refinement.paced_out); a solve whose iterations are fast enough never notices the pace.
+all on a plan that verifies: its first solve up to the rung's cap, and refinement rounds after it nearly as many
+again (most take far fewer; a large NLP, the Fetch's, can run the cap without verifying): a rung that could not do
+that much work in its time would end at its time limit, most often unverified. Where an iteration is slow (a large
+NLP: the Fetch's thousands of self-collision rows) it gives that time to the safety net, which times the same
+path, instead (no screening rebuild follows a solve stopped by time: ocpkit.planner.simultaneous, and its motion
+is not verified: ocpkit.planner.refinement.paced_out); a solve whose iterations are fast enough never notices the
+pace.
 
 A rung whose plan fails only checks that no refinement round can fix (the dynamics residual between knots, with
 every path constraint met: `Verification.fixable` is False) is followed at once by its `finer` rung: the same
@@ -94,7 +95,7 @@ MAX_WALL_TIME = 30.0  # s of computation and set-up for the whole ladder, the si
 OMPL_CHECKS = 1_500_000  # configurations an OMPL rung may check for its path
 OMPL_RESOLUTION = 0.02  # rad between the configurations an OMPL rung checks along an edge (the seed's default: 0.01)
 FINER_ITERATIONS = 50  # IPOPT iterations per solve of a finer rung; no refinement round starts after that many
-PACE_ITERATIONS = 250  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
+PACE_ITERATIONS = 550  # an OMPL rung's first solve stops once this many iterations at its pace would overrun it
 RUNG_SHARE = 0.5  # of the budget: the most a capped rung may take
 RESERVE_SHARE = 0.03  # of the budget: held back from every rung for what runs past its time (module docstring)
 NET_KNOTS, NET_SEGMENTS = 8, 4  # a safety net's timing grid: 4 pseudospectral segments of 8 intervals (docstring)
