@@ -228,18 +228,18 @@ class CasadiNlpsol(Solver):
 
 
 class Ipopt(CasadiNlpsol):
-    """IPOPT (interior point) with the exact Hessian by CasADi AD and the MUMPS linear solver.
+    """IPOPT (interior point) with the exact Hessian (CasADi's AD; the collision rows' in closed form) and MUMPS.
 
     L-BFGS stands in when the NLP has no exact Hessian. The constraint Jacobian and the Hessian are built point
     by point where the NLP has point calls (ocpkit.solvers.pointwise: the same values, a cheaper set-up), the
-    dynamics rows' through point derivatives compiled to C once per robot and machine unless `compiled` is False
-    (ocpkit.solvers.compiled); extra keyword options go to IPOPT verbatim (e.g. tol=1e-8). MUMPS starts without
-    threshold pivoting (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out
-    inaccurate) and orders the KKT system by approximate minimum fill (mumps_pivot_order 2, where MUMPS's
-    automatic choice takes PORD), both faster on our KKT systems. The barrier parameter stays below mu_max = 10⁻³
-    (IPOPT's default 10⁵): the adaptive strategy otherwise falls back to a monotone barrier of ~0.1 on a slow
-    iterate, which pushes a start near a solution far from it: t_f up towards its bound, then slowly back
-    (figures: docs/design-notes.md)."""
+    dynamics rows' through point derivatives compiled to C once per robot and machine (ocpkit.solvers.compiled) and
+    the collision rows' through hand-written C (ocpkit.solvers.collision_derivatives), unless `compiled` is False;
+    extra keyword options go to IPOPT verbatim (e.g. tol=1e-8). MUMPS starts without threshold pivoting
+    (mumps_pivtol 0; IPOPT raises it towards mumps_pivtolmax whenever a solve comes out inaccurate) and orders the
+    KKT system by approximate minimum fill (mumps_pivot_order 2, where MUMPS's automatic choice takes PORD), both
+    faster on our KKT systems. The barrier parameter stays below mu_max = 10⁻³ (IPOPT's default 10⁵): the adaptive
+    strategy otherwise falls back to a monotone barrier of ~0.1 on a slow iterate, which pushes a start near a
+    solution far from it: t_f up towards its bound, then slowly back (figures: docs/design-notes.md)."""
 
     name = plugin = "ipopt"
     statuses = {
