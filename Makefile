@@ -32,13 +32,13 @@ chromium:
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; } || \
 		{ echo "install chromium (apt-get install chromium) for the report and viewer tests"; exit 1; }
 
-# The dynamics derivatives (once per robot) and the path search's collision test (once) are compiled to C
-# (ocpkit.solvers.compiled): a C compiler (Debian's gcc, installed as root); without one the planner runs them
-# uncompiled (CasADi's virtual machine, coal's collision test), the same answers, slower.
+# The dynamics derivatives (once per robot), the collision rows' derivatives and the path search's collision test
+# (once) are compiled to C (ocpkit.solvers.compiled): a C compiler (Debian's gcc, installed as root); without one
+# the planner runs them uncompiled (CasADi's virtual machine, coal's collision test), the same answers, slower.
 compiler:
 	@command -v "$${CC:-cc}" >/dev/null || { [ "$$(id -u)" = 0 ] && apt-get update -qq && \
 		DEBIAN_FRONTEND=noninteractive apt-get install -y -qq gcc; } || \
-		echo "no C compiler: the dynamics derivatives and the collision test run uncompiled (slower); apt-get install gcc"
+		echo "no C compiler: the derivatives and the collision test run uncompiled (slower); apt-get install gcc"
 
 clean:
 	rm -rf $(VENV) results site
