@@ -97,3 +97,17 @@ def quintic(problem, tf: float, tau_offset: float = 0.0) -> Trajectory:
 def load(data: dict) -> Problem:
     """The Problem of scenario `data` (a copy: the caller's dict is untouched), paths relative to the repository."""
     return problem_from_dict(copy.deepcopy(data), base_dir=REPO)
+
+
+def unaligned_chain() -> tuple[pin.Model, tuple[int, ...]]:
+    """A pinocchio model (with bodies) of a prismatic joint, an unaligned prismatic one, an unaligned revolute one
+    and a revolute one in a chain, each placed tilted and offset in its parent, and the four joints' ids."""
+    model = pin.Model()
+    tilted = pin.SE3(pin.rpy.rpyToMatrix(0.3, -0.2, 0.5), np.array([0.1, 0.2, 0.3]))
+    a = model.addJoint(0, pin.JointModelPY(), tilted, "slide")
+    b = model.addJoint(a, pin.JointModelPrismaticUnaligned(np.array([0.6, 0.0, 0.8])), tilted, "slide2")
+    c = model.addJoint(b, pin.JointModelRevoluteUnaligned(np.array([0.0, 0.6, 0.8])), tilted, "turn")
+    d = model.addJoint(c, pin.JointModelRZ(), tilted, "wrist")
+    for joint in (a, b, c, d):
+        model.appendBodyToJoint(joint, pin.Inertia.Random(), pin.SE3.Identity())
+    return model, (a, b, c, d)

@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 import pinocchio as pin
 import pytest
-from helpers import REPO
+from helpers import REPO, unaligned_chain
 
 import ocpkit
 from ocpkit.bench.random import random_problems
@@ -70,20 +70,16 @@ def test_the_workspace_faces_bound_from_outside(check):
 
 def test_the_compiled_test_follows_prismatic_and_unaligned_joints():
     rng = np.random.default_rng(6)
-    model = pin.Model()
-    tilted = pin.SE3(pin.rpy.rpyToMatrix(0.3, -0.2, 0.5), np.array([0.1, 0.2, 0.3]))
-    a = model.addJoint(0, pin.JointModelPY(), tilted, "slide")
-    b = model.addJoint(a, pin.JointModelPrismaticUnaligned(np.array([0.6, 0.0, 0.8])), tilted, "slide2")
-    c = model.addJoint(b, pin.JointModelRevoluteUnaligned(np.array([0.0, 0.6, 0.8])), tilted, "turn")
+    model, (a, b, c, d) = unaligned_chain()
     base = ocpkit.load_robot("industrial6")
-    joints = np.array([0, a, a, b, c, c, b])  # not in joint order: the test sorts them into links
+    joints = np.array([0, a, a, b, c, d, b])  # not in joint order: the test sorts them into links
     robot = dataclasses.replace(base, model=model, sphere_joint=joints, sphere_offset=rng.normal(0, 0.3, (7, 3)),
                                 sphere_radius=rng.uniform(0.05, 0.2, 7),
                                 self_collision=np.array([[1, 4], [5, 2], [6, 1]]))
     boxes = Boxes(np.array([[0.4, 0.5, 0.6]]), np.array([[0.3, 0.8, 0.2]]), pin.rpy.rpyToMatrix(0.4, 0.1, -0.7)[None])
     problem = dataclasses.replace(problems()[0][1], robot=robot,
                                   scene=Scene(np.array([[-0.5, 0.2, 0.9]]), np.array([0.3]), boxes=boxes))
-    q = rng.uniform(-1, 1, (3000, 3))
+    q = rng.uniform(-1, 1, (3000, 4))
     smallest = smallest_clearance(problem, q)
     assert 0.1 < (smallest >= MARGIN).mean() < 0.9
     np.testing.assert_array_equal(SphereCheck(robot, problem.scene, MARGIN).free(q), smallest >= MARGIN)

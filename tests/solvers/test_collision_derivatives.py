@@ -12,7 +12,7 @@ import casadi as ca
 import numpy as np
 import pinocchio as pin
 import pytest
-from helpers import REPO
+from helpers import REPO, unaligned_chain
 
 import ocpkit
 from ocpkit.constraints import Context, PointValues
@@ -46,14 +46,7 @@ def grouped(constraint: SphereCollision) -> SphereCollision:
 def prismatic_problem() -> ocpkit.Problem:
     """Spheres on a chain of prismatic, unaligned and revolute joints among a sphere, a box and a cylinder."""
     rng = np.random.default_rng(6)
-    model = pin.Model()
-    tilted = pin.SE3(pin.rpy.rpyToMatrix(0.3, -0.2, 0.5), np.array([0.1, 0.2, 0.3]))
-    a = model.addJoint(0, pin.JointModelPY(), tilted, "slide")
-    b = model.addJoint(a, pin.JointModelPrismaticUnaligned(np.array([0.6, 0.0, 0.8])), tilted, "slide2")
-    c = model.addJoint(b, pin.JointModelRevoluteUnaligned(np.array([0.0, 0.6, 0.8])), tilted, "turn")
-    d = model.addJoint(c, pin.JointModelRZ(), tilted, "wrist")
-    for joint in (a, b, c, d):
-        model.appendBodyToJoint(joint, pin.Inertia.Random(), pin.SE3.Identity())
+    model, (a, b, c, d) = unaligned_chain()
     joints = np.array([0, a, a, b, c, c, d, d])
     robot = dataclasses.replace(PAPER.robot, model=model, sphere_joint=joints,
                                 sphere_offset=rng.normal(0, 0.3, (8, 3)), sphere_radius=rng.uniform(0.05, 0.2, 8),
