@@ -228,7 +228,7 @@ class CasadiNlpsol(Solver):
 
 
 class Ipopt(CasadiNlpsol):
-    """IPOPT (interior point) with the exact Hessian (CasADi's AD; the collision rows' in closed form) and MUMPS.
+    """IPOPT (interior point) with the exact Hessian and the MUMPS linear solver.
 
     L-BFGS stands in when the NLP has no exact Hessian. The constraint Jacobian and the Hessian are built point
     by point where the NLP has point calls (ocpkit.solvers.pointwise: the same values, a cheaper set-up), the
