@@ -24,6 +24,7 @@ from ocpkit.geometry.scene import Scene
 from ocpkit.robots import Robot
 from ocpkit.solvers.chain import INT, REAL, Chain, CArrays, chain, chain_work, kernel
 
+
 class _Model(ctypes.Structure):
     """sphere_check.c's Model, field for field."""
 
