@@ -40,8 +40,8 @@ AXES = {"X": 0, "Y": 1, "Z": 2}
 
 @dataclass(frozen=True)
 class ChainJoint:
-    """One 1-DoF joint of a robot's model as `sphere_centers_batch` (and the path search's compiled test,
-    ocpkit.planner.sphere_check) composes it: its parent joint, its q index, its placement in the parent (rotation
+    """One 1-DoF joint of a robot's model as `sphere_centers_batch` (and the hand-written C kernels,
+    ocpkit.solvers.chain) composes it: its parent joint, its q index, its placement in the parent (rotation
     (3, 3), translation (3,)); revolute: the cross-product matrix [a]x of its axis and [a]x² (Rodrigues),
     prismatic: the axis in the parent's frame."""
 

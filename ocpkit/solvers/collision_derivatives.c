@@ -17,6 +17,8 @@ typedef struct {
     int spheres;
     const int *sphere_joint;                   /* (M,) */
     const double *offset, *radius;             /* (M, 3), (M,): centre in its joint's frame, radius */
+    int used;
+    const int *used_spheres;                   /* (U,): the spheres some row reads (the others are not computed) */
     int terms;                                 /* T, in the rows' evaluation order (their margin caps' order) */
     const int *kind, *first, *second;          /* (T,): 0 pair (spheres first, second), 1 sphere first against
                                                   obstacle sphere second, 2 box second, 3 cylinder second */
@@ -164,8 +166,10 @@ void collision_derivatives(const Model *m, const Scene *sc, const double *q, int
         double *hess_point = hess ? hess + (long)point * n * n : 0;
         const double *lam_point = lam ? lam + (long)point * rows : 0;
         kinematics(&m->chain, q + (long)point * n, rotation, origin, axis);
-        for (int s = 0; s < m->spheres; ++s)
+        for (int k = 0; k < m->used; ++k) {
+            const int s = m->used_spheres[k];
             sphere_jacobian(m, s, rotation, origin, axis, centers + 3 * s, jacobians + 3 * n * s);
+        }
         if (hess_point) {
             memset(hess_point, 0, n * n * sizeof(double));
             memset(weights, 0, 3 * m->spheres * sizeof(double));
@@ -230,7 +234,8 @@ void collision_derivatives(const Model *m, const Scene *sc, const double *q, int
             if (hess_point) weights[3 * s + x] += lam_point[r] * slope;
         }
         if (!hess_point) continue;
-        for (int s = 0; s < m->spheres; ++s) {
+        for (int k = 0; k < m->used; ++k) {
+            const int s = m->used_spheres[k];
             const double *w = weights + 3 * s;
             if (w[0] != 0.0 || w[1] != 0.0 || w[2] != 0.0)
                 add_curvature(m, s, axis, jacobians + 3 * n * s, w, hess_point);

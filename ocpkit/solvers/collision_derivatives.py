@@ -29,14 +29,15 @@ from ocpkit.geometry.clearances import joint_chain
 from ocpkit.robots import Robot
 from ocpkit.solvers.chain import INT, REAL, Chain, CArrays, chain, chain_work, kernel
 
+
 class _Model(ctypes.Structure):
     """collision_derivatives.c's Model, field for field."""
 
     _fields_ = [("chain", Chain), ("spheres", ctypes.c_int), ("sphere_joint", INT), ("offset", REAL),
-                ("radius", REAL), ("terms", ctypes.c_int), ("kind", INT), ("first", INT), ("second", INT),
-                ("groups", ctypes.c_int), ("group_start", INT), ("group_terms", INT), ("faces", ctypes.c_int),
-                ("face_sphere", INT), ("face_axis", INT), ("face_sides", INT), ("sharpness", ctypes.c_double),
-                ("radial_eps", ctypes.c_double)]
+                ("radius", REAL), ("used", ctypes.c_int), ("used_spheres", INT), ("terms", ctypes.c_int),
+                ("kind", INT), ("first", INT), ("second", INT), ("groups", ctypes.c_int), ("group_start", INT),
+                ("group_terms", INT), ("faces", ctypes.c_int), ("face_sphere", INT), ("face_axis", INT),
+                ("face_sides", INT), ("sharpness", ctypes.c_double), ("radial_eps", ctypes.c_double)]
 
 
 class _Scene(ctypes.Structure):
@@ -87,9 +88,11 @@ class CollisionDerivatives:
         self.dof, self.rows = robot.model.nq, len(terms.groups) + len(terms.face_sphere)
         starts = np.cumsum([0, *map(len, terms.groups)])
         members = np.concatenate([np.zeros(0, int), *terms.groups])
+        used = np.unique(np.concatenate([terms.first, terms.second[terms.kind == 0], terms.face_sphere]))
         self.model = _Model(
             chain(robot, arrays), len(robot.sphere_radius), arrays.ints(robot.sphere_joint),
-            arrays.reals(robot.sphere_offset), arrays.reals(robot.sphere_radius), len(terms.kind),
+            arrays.reals(robot.sphere_offset), arrays.reals(robot.sphere_radius), len(used), arrays.ints(used),
+            len(terms.kind),
             arrays.ints(terms.kind), arrays.ints(terms.first), arrays.ints(terms.second), len(terms.groups),
             arrays.ints(starts), arrays.ints(members), len(terms.face_sphere), arrays.ints(terms.face_sphere),
             arrays.ints(terms.face_axis), arrays.ints(terms.face_sides), SOFTMIN_SHARPNESS, RADIAL_EPS)
@@ -179,17 +182,16 @@ class _Mapped(ca.Callback):
         return ca.Sparsity.dense(*self.out_shape)
 
     def eval(self, arguments: list[ca.DM]) -> list[ca.DM]:
-        values = [np.asarray(a.full()) for a in arguments]
         first = self.differentiated  # the margin; the limit scale, then the constraint's parameters follow
-        parameters = {name: values[first + 2 + k] for k, name in enumerate(self.derivatives.parameters)}
+        parameters = {name: arguments[first + 2 + k] for k, name in enumerate(self.derivatives.parameters)}
         arrays = CArrays()  # what the Scene points to, alive through the call
 
         def reals(name: str, width: int) -> Any:
-            return arrays.reals(parameters[name][:, :width])  # the first call's columns: every call's are the same
+            return arrays.reals(parameters[name][:, :width].full())  # the first call's: every call's are the same
 
-        scene = _Scene(float(values[first][0, 0]), reals("margin_cap", 1), reals("obstacle_center", 3),
+        scene = _Scene(float(arguments[first][0, 0]), reals("margin_cap", 1), reals("obstacle_center", 3),
                        reals("obstacle_radius", 1), reals("box_center", 3), reals("box_half_size", 3),
                        reals("box_rotation", 9), reals("cylinder_center", 3), reals("cylinder_half_size", 2),
                        reals("cylinder_rotation", 9), reals("workspace", 1))
-        lam = values[-1].T if self.hessian else None
-        return [ca.DM(self.derivatives.evaluate(values[0].T, scene, lam).T)]
+        lam = arguments[-1].full().T if self.hessian else None
+        return [ca.DM(self.derivatives.evaluate(arguments[0].full().T, scene, lam).T)]

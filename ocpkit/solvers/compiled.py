@@ -7,7 +7,8 @@ with casadi.external: the same values as CasADi's virtual machine, evaluated fas
 A library is written under a temporary name and renamed into place, so processes compiling the same C at once do
 not clash.
 Without a compiler, or when a compile or the loading fails, there is nothing to load: None, with one warning.
-`shared_library(source)` is the same cache for C written by hand (ocpkit.planner.sphere_check).
+`shared_library(source)` is the same cache for C written by hand (ocpkit.solvers.chain: the path search's collision
+test, the collision rows' derivatives).
 """
 
 from __future__ import annotations
